@@ -1,0 +1,23 @@
+"""The main job: both nodes in one process, sharing one world and one motion-queue executor.
+
+    python -m acti_bringup [--ros-args ...]
+"""
+from __future__ import annotations
+
+import sys
+
+import rclpy
+
+from acti_middle_node.node import ArmNode
+from vehicle_node.node import VehicleNode
+
+
+def main(args: list[str] | None = None) -> None:
+    rclpy.init(args=sys.argv if args is None else args)
+    arm = ArmNode()
+    vehicle = VehicleNode(simulation=arm.simulation)
+    arm.simulation.spin(arm, vehicle)
+
+
+if __name__ == "__main__":
+    main()

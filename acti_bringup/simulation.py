@@ -1,0 +1,74 @@
+"""The simulation a process hosts: one PyBullet world and one motion-queue executor, with the
+topics that belong to the world as a whole (/clock and joint_states)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import rclpy
+from builtin_interfaces.msg import Time
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.node import Node
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+
+from acti_bringup.parameters import declare_config
+from acti_motion.executor import MotionExecutor
+from acti_sim.world import World
+
+
+@dataclass
+class SimulationConfig:
+    rate_hz: float = 240.0
+    real_time_factor: float = 1.0
+    joint_state_rate_hz: float = 50.0
+
+
+def stamp(node_time: float) -> Time:
+    sec = int(node_time)
+    return Time(sec=sec, nanosec=int((node_time - sec) * 1e9))
+
+
+class Simulation:
+    """World + executor, created from the parameters of the node that hosts it."""
+
+    def __init__(self, node: Node) -> None:
+        self.config = c = declare_config(node, SimulationConfig)
+        if c.rate_hz <= 0 or c.real_time_factor < 0 or c.joint_state_rate_hz <= 0:
+            raise ValueError("rate_hz and joint_state_rate_hz must be > 0, real_time_factor >= 0")
+        self.world = World(time_step=1.0 / c.rate_hz)
+        self.executor = MotionExecutor(self.world, c.real_time_factor)
+        self._clock = node.create_publisher(Clock, "/clock", 10)
+        self._joints = node.create_publisher(JointState, "joint_states", 10)
+        self.executor.after_step(self._publish_clock)
+        self.executor.after_step(self._publish_joint_states,
+                                 every=max(1, round(c.rate_hz / c.joint_state_rate_hz)))
+
+    def now(self) -> Time:
+        return stamp(self.world.time)
+
+    def _publish_clock(self, world: World) -> None:
+        self._clock.publish(Clock(clock=self.now()))
+
+    def _publish_joint_states(self, world: World) -> None:
+        names, pos, vel = world.joint_states()
+        msg = JointState(name=names, position=pos, velocity=vel)
+        msg.header.stamp = self.now()
+        self._joints.publish(msg)
+
+    def spin(self, *nodes: Node) -> None:
+        """Run the simulation and serve the nodes until SIGINT/SIGTERM, then clean up."""
+        executor = MultiThreadedExecutor(num_threads=6)
+        for n in nodes:
+            executor.add_node(n)
+        self.executor.start()
+        try:
+            executor.spin()
+        except (KeyboardInterrupt, ExternalShutdownException):
+            pass
+        finally:
+            self.executor.shutdown()
+            executor.shutdown()
+            for n in nodes:
+                n.destroy_node()
+            self.world.close()
+            rclpy.try_shutdown()

@@ -1,0 +1,281 @@
+"""The shared motion-queue executor: one simulation thread, one bounded FIFO per device.
+
+Cores (arm, vehicle) plan motions on their own threads and hand finished `Motion`s to a `Device`.
+The simulation thread steps the world at a fixed rate and advances each device's current motion.
+Pause, resume and stop never wait for planning: they only change the device's time rate, which the
+simulation thread ramps linearly, so every motion decelerates along its own path.
+"""
+from __future__ import annotations
+
+import threading
+import time
+from collections import deque
+from dataclasses import dataclass
+from typing import Any, Callable, Protocol
+
+from acti_sim.world import World
+
+
+class Motion(Protocol):
+    """A planned motion: what to command at time t (s) into it, and the set-point there."""
+    duration: float
+
+    def apply(self, world: World, t: float, rate: float) -> None:
+        """Command the world for time t; `rate` scales the feed-forward velocity (0 when held)."""
+
+    def at(self, t: float) -> Any:
+        """The set-point at time t (the device's own kind: joint vector, pose …)."""
+
+
+@dataclass
+class QueuedMotion:
+    id: int
+    motion: Motion
+    label: str
+
+
+class Device:
+    """One bounded FIFO of motions with pause/resume/stop by time scaling.
+
+    Motion ids grow by one per accepted motion; `retired_id` is the highest id that finished or
+    was discarded, so "is motion n over?" is `retired_id >= n` (the queue is FIFO).
+    """
+
+    def __init__(self, name: str, capacity: int, hold: Any) -> None:
+        self.name = name
+        self.capacity = capacity
+        self.hold = hold
+        self.queued_end = hold
+        self._accept = threading.Lock()
+        self.lock = threading.Lock()
+        self.changed = threading.Condition(self.lock)
+        self.queue: deque[QueuedMotion] = deque()
+        self.current: QueuedMotion | None = None
+        self.t = 0.0
+        self.rate = 1.0
+        self._rate_target = 1.0
+        self._ramp = 1.0
+        self._stop_at: float | None = None
+        self.paused = False
+        self.generation = 0
+        self.last_id = 0
+        self.retired_id = 0
+        self.completed = 0
+        self.discarded = 0
+
+    # --- called by cores (any thread) -------------------------------------------------------
+    @property
+    def moving(self) -> bool:
+        return self.current is not None
+
+    @property
+    def busy(self) -> bool:
+        """Something is running or waiting to run."""
+        return self.current is not None or bool(self.queue)
+
+    @property
+    def queue_length(self) -> int:
+        return len(self.queue)
+
+    @property
+    def full(self) -> bool:
+        return len(self.queue) >= self.capacity
+
+    def submit(self, plan: Callable[[Any], Motion], label: str) -> int | None:
+        """Plan a motion from the end of the last queued one and append it; its id, or None when
+        the queue is full. Planning runs on the caller's thread, never under the lock that pause,
+        stop and the simulation take; a stop that comes in meanwhile makes it plan again from the
+        new end. Exceptions of `plan` (a refusal) pass through and queue nothing.
+        """
+        with self._accept:
+            while True:
+                with self.lock:
+                    if len(self.queue) >= self.capacity:
+                        return None
+                    generation, start = self.generation, self.queued_end
+                motion = plan(start)
+                with self.lock:
+                    if generation != self.generation:
+                        continue
+                    if len(self.queue) >= self.capacity:
+                        return None
+                    self.last_id += 1
+                    self.queue.append(QueuedMotion(self.last_id, motion, label))
+                    self.queued_end = motion.at(motion.duration)
+                    self.changed.notify_all()
+                    return self.last_id
+
+    def pause(self, ramp: float) -> bool:
+        """Decelerate over `ramp` seconds and hold; the queue stays. False when already paused."""
+        with self.lock:
+            if self.paused:
+                return False
+            self.paused = True
+            self._set_rate(0.0, ramp)
+            return True
+
+    def resume(self, ramp: float) -> bool:
+        """Undo a pause, accelerating over `ramp` seconds. False when not paused."""
+        with self.lock:
+            if not self.paused or self._stop_at is not None:
+                return False
+            self.paused = False
+            self._set_rate(1.0, ramp)
+            return True
+
+    def stop(self, ramp: float) -> None:
+        """Discard the queue, clear a pause and decelerate the current motion over `ramp` seconds.
+
+        The rate falls linearly, so the motion's clock advances rate² · ramp / 2 more seconds: the
+        rest point is known now and becomes the start of whatever is queued next.
+        """
+        with self.lock:
+            self.generation += 1
+            self._retire_queue()
+            self.paused = False
+            cur = self.current
+            if cur is None:
+                self.rate = self._rate_target = 1.0
+                self.queued_end = self.hold
+                return
+            if self._stop_at is None:
+                self._stop_at = min(cur.motion.duration, self.t + self.rate * self.rate * ramp / 2)
+            self._set_rate(0.0, ramp)
+            self.queued_end = cur.motion.at(self._stop_at)
+
+    def wait(self, motion_id: int, timeout: float | None) -> bool:
+        """Block until motion `motion_id` (0: everything queued now) is over; False on timeout."""
+        deadline = None if timeout is None else time.monotonic() + timeout
+        with self.lock:
+            target = self.last_id if motion_id <= 0 else motion_id
+            while self.retired_id < target:
+                left = None if deadline is None else deadline - time.monotonic()
+                if left is not None and left <= 0:
+                    return False
+                self.changed.wait(left)
+            return True
+
+    def progress(self) -> tuple[int, float]:
+        """(current motion id or 0, its completed fraction)."""
+        cur = self.current
+        if cur is None:
+            return 0, 0.0
+        d = cur.motion.duration
+        return cur.id, 1.0 if d <= 0 else min(1.0, self.t / d)
+
+    # --- called by the simulation thread -----------------------------------------------------
+    def tick(self, world: World, dt: float) -> None:
+        with self.lock:
+            if self.current is None:
+                if self.paused or not self.queue:
+                    return
+                self.current = self.queue.popleft()
+                self.t = 0.0
+                self.changed.notify_all()
+            r0 = self.rate
+            step = dt / self._ramp if self._ramp > 0 else 1.0
+            r1 = min(self._rate_target, r0 + step) if r0 < self._rate_target else max(self._rate_target, r0 - step)
+            self.rate = r1
+            self.t += dt * (r0 + r1) / 2
+            cur = self.current
+            if self._stop_at is not None and (r1 <= 0.0 or self.t >= self._stop_at):
+                self.t = self._stop_at
+                cur.motion.apply(world, self.t, 0.0)
+                self._finish(discarded=True)
+                return
+            end = self.t >= cur.motion.duration
+            cur.motion.apply(world, min(self.t, cur.motion.duration), 0.0 if end else r1)
+            if end:
+                self._finish(discarded=False)
+
+    # --- internals (lock held) ---------------------------------------------------------------
+    def _set_rate(self, target: float, ramp: float) -> None:
+        self._rate_target = target
+        self._ramp = max(ramp, 1e-6)
+
+    def _finish(self, discarded: bool) -> None:
+        assert self.current is not None
+        self.hold = self.current.motion.at(self.t)
+        self.retired_id = max(self.retired_id, self.current.id)
+        if discarded:
+            self.discarded += 1
+            self._stop_at = None
+            self.rate = self._rate_target = 1.0
+        else:
+            self.completed += 1
+        self.current = None
+        self.changed.notify_all()
+
+    def _retire_queue(self) -> None:
+        if self.queue:
+            self.discarded += len(self.queue)
+            self.retired_id = max(self.retired_id, self.queue[-1].id)
+            self.queue.clear()
+            self.changed.notify_all()
+
+
+StepListener = Callable[[World], None]
+
+
+class MotionExecutor:
+    """Steps the world (at its own fixed time step) on a thread of its own, `real_time_factor`
+    times faster than wall time (0: as fast as it can), and advances every device each step."""
+
+    def __init__(self, world: World, real_time_factor: float = 1.0) -> None:
+        self.world = world
+        self.dt = world.time_step
+        self.real_time_factor = real_time_factor
+        self.devices: dict[str, Device] = {}
+        self._before: list[StepListener] = []
+        self._after: list[tuple[int, StepListener]] = []
+        self._thread: threading.Thread | None = None
+        self._running = threading.Event()
+        self.steps = 0
+
+    def add_device(self, name: str, capacity: int, hold: Any) -> Device:
+        """A motion queue whose device rests at set-point `hold` until its first motion."""
+        device = Device(name, capacity, hold)
+        self.devices[name] = device
+        return device
+
+    def before_step(self, fn: StepListener) -> None:
+        """Run fn(world) on the simulation thread before the devices are advanced."""
+        self._before.append(fn)
+
+    def after_step(self, fn: StepListener, every: int = 1) -> None:
+        """Run fn(world) on the simulation thread after every `every`-th physics step."""
+        self._after.append((max(1, every), fn))
+
+    def step(self) -> None:
+        """One control cycle: listeners, devices, physics. Used by the thread and by unit tests."""
+        world = self.world
+        for fn in self._before:
+            fn(world)
+        for device in self.devices.values():
+            device.tick(world, self.dt)
+        world.step()
+        self.steps += 1
+        for every, fn in self._after:
+            if self.steps % every == 0:
+                fn(world)
+
+    def start(self) -> None:
+        self._running.set()
+        self._thread = threading.Thread(target=self._loop, name="acti-sim", daemon=True)
+        self._thread.start()
+
+    def shutdown(self) -> None:
+        self._running.clear()
+        if self._thread is not None:
+            self._thread.join(timeout=5.0)
+            self._thread = None
+
+    def _loop(self) -> None:
+        wall0 = time.monotonic()
+        sim0 = self.world.time
+        while self._running.is_set():
+            self.step()
+            if self.real_time_factor > 0:
+                ahead = (self.world.time - sim0) / self.real_time_factor - (time.monotonic() - wall0)
+                if ahead > 0:
+                    time.sleep(ahead)

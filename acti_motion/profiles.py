@@ -1,0 +1,45 @@
+"""Time profiles: the synchronized trapezoid that PTP moves and straight base moves share."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Trapezoid:
+    """Normalised progress s(t) in [0, 1] with equal accel and decel time `ramp`.
+
+    `duration` = max(cruise_time, ramp) + ramp, so a short move becomes a triangle with the same
+    ramp; every axis that scales this profile starts and stops together (the spec's PTP rule).
+    """
+    duration: float
+    ramp: float
+
+    @classmethod
+    def for_axes(cls, distance: np.ndarray, max_speed: np.ndarray, ramp: float) -> "Trapezoid":
+        """Profile for axes moving `distance` at no more than `max_speed` each (same units)."""
+        distance = np.abs(np.asarray(distance, float))
+        if not np.any(distance > 0.0):
+            return cls(0.0, 0.0)
+        cruise = float(np.max(distance / np.asarray(max_speed, float)))
+        return cls(max(cruise, ramp) + ramp, ramp)
+
+    @property
+    def peak(self) -> float:
+        """Peak of ds/dt (1/s)."""
+        return 1.0 / (self.duration - self.ramp) if self.duration > 0.0 else 0.0
+
+    def sample(self, t: float) -> tuple[float, float]:
+        """(s, ds/dt) at time t, clamped to the profile's ends."""
+        T, ta, v = self.duration, self.ramp, self.peak
+        if T <= 0.0 or t >= T:
+            return 1.0, 0.0
+        if t <= 0.0:
+            return 0.0, 0.0
+        if t < ta:
+            return v * t * t / (2 * ta), v * t / ta
+        if t <= T - ta:
+            return v * (t - ta / 2), v
+        r = T - t
+        return 1.0 - v * r * r / (2 * ta), v * r / ta

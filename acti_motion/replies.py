@@ -1,0 +1,90 @@
+"""What a core operation answers: the arm's RETURN_ID and the vehicle's boolean + message.
+
+Cores raise `Refused` where an operation is refused; `answers` turns that into the port's reply,
+so every check reads as one line and every refusal carries a comment for a person.
+"""
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass, field
+from enum import IntEnum
+from typing import Any, Callable, Iterable
+
+import numpy as np
+
+
+class ReturnCode(IntEnum):
+    """RETURN_ID.id of the ACT ports (middle-level spec table 3; NOT_IMPLEMENTED from 2014)."""
+    OK = 0
+    NG = -1
+    STATUS_ERR = -2
+    VALUE_ERR = -3
+    NOT_SV_ON_ERR = -4
+    FULL_MOTION_QUEUE_ERR = -5
+    NOT_IMPLEMENTED = -6
+
+
+class Refused(Exception):
+    """An operation refused with `code` (a ReturnCode; the vehicle maps every code to false)."""
+
+    def __init__(self, code: ReturnCode, comment: str) -> None:
+        super().__init__(comment)
+        self.code = code
+        self.comment = comment
+
+
+@dataclass
+class Reply:
+    """The outcome of one operation: code, comment and the out parameters by IDL name."""
+    code: ReturnCode = ReturnCode.OK
+    comment: str = ""
+    values: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return self.code == ReturnCode.OK
+
+
+def answers(fn: Callable[..., dict[str, Any] | Reply | None]) -> Callable[..., Reply]:
+    """Wrap a core operation: its out-values dict becomes an OK reply, `Refused` a refusal."""
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Reply:
+        try:
+            out = fn(*args, **kwargs)
+        except Refused as r:
+            return Reply(r.code, r.comment)
+        if isinstance(out, Reply):
+            return out
+        return Reply(values=out or {})
+    return wrapper
+
+
+def value_error(what: str) -> Refused:
+    return Refused(ReturnCode.VALUE_ERR, what)
+
+
+def finite_vector(values: Iterable[float], length: int | tuple[int, ...], name: str) -> np.ndarray:
+    """`values` as a float vector of an allowed length with only finite numbers, else VALUE_ERR."""
+    v = np.asarray(list(values), dtype=float).reshape(-1)
+    allowed = (length,) if isinstance(length, int) else length
+    if len(v) not in allowed:
+        want = " or ".join(str(n) for n in allowed)
+        raise value_error(f"{name} needs {want} values, got {len(v)}")
+    bad = [i for i, x in enumerate(v) if not math.isfinite(x)]
+    if bad:
+        raise value_error(f"{name}[{bad[0]}] is {v[bad[0]]}: every value must be a finite number")
+    return v
+
+
+def finite_number(x: float, name: str) -> float:
+    if not math.isfinite(x):
+        raise value_error(f"{name} is {x}: it must be a finite number")
+    return float(x)
+
+
+def ratio_percent(x: int, name: str) -> int:
+    """A percentage 0 … 100 (the spec's ULONG ratios), else VALUE_ERR."""
+    if not 0 <= x <= 100:
+        raise value_error(f"{name} is {x} %: it must be within 0 … 100 %")
+    return int(x)

@@ -1,0 +1,159 @@
+"""The PyBullet world of the mobile manipulator: one headless physics client, stepped by its owner.
+
+The world knows nothing of queues, services or ROS: it takes joint and wheel set-points and reports
+what the physics did (joint positions, wheel rotation, ground-truth base pose, bumper contacts).
+"""
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+
+import numpy as np
+import pybullet
+import pybullet_data
+from pybullet_utils import bullet_client
+
+URDF_PATH = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                         "urdf", "mobile_manipulator.urdf")
+ARM_JOINTS = tuple(f"joint{i}" for i in range(1, 8))
+GRIPPER_JOINTS = ("gripper_finger_left_joint", "gripper_finger_right_joint")
+WHEEL_JOINTS = ("left_wheel_joint", "right_wheel_joint")
+BUMPER_LINK = "bumper"
+CASTER_LINKS = ("front_caster", "rear_caster")
+
+
+@dataclass(frozen=True)
+class JointLimit:
+    """Limits of one joint as the URDF states them (rad, rad/s, N·m; m and m/s for prismatic)."""
+    lower: float
+    upper: float
+    velocity: float
+    effort: float
+
+
+class World:
+    """A headless PyBullet simulation of the robot on a flat floor."""
+
+    def __init__(self, time_step: float = 1.0 / 240.0, urdf_path: str = URDF_PATH) -> None:
+        self.time_step = time_step
+        self.time = 0.0
+        self._p = bullet_client.BulletClient(connection_mode=pybullet.DIRECT)
+        p = self._p
+        p.setAdditionalSearchPath(pybullet_data.getDataPath())
+        p.setGravity(0, 0, -9.81)
+        p.setTimeStep(time_step)
+        self.plane = p.loadURDF("plane.urdf")
+        self.robot = p.loadURDF(urdf_path, [0, 0, 0.1], useFixedBase=False,
+                                flags=pybullet.URDF_USE_INERTIA_FROM_FILE)
+        self._joint = {}
+        self._link = {}
+        self.limits: dict[str, JointLimit] = {}
+        for j in range(p.getNumJoints(self.robot)):
+            info = p.getJointInfo(self.robot, j)
+            name = info[1].decode()
+            self._joint[name] = j
+            self._link[info[12].decode()] = j
+            self.limits[name] = JointLimit(info[8], info[9], info[11], info[10])
+        # Free all motors; every driven joint gets an explicit motor below.
+        for j in self._joint.values():
+            p.setJointMotorControl2(self.robot, j, pybullet.VELOCITY_CONTROL, force=0)
+        for name in CASTER_LINKS:
+            p.changeDynamics(self.robot, self._link[name], lateralFriction=0.0,
+                             rollingFriction=0.0, spinningFriction=0.0)
+        for name in WHEEL_JOINTS:
+            p.changeDynamics(self.robot, self._joint[name], lateralFriction=1.5)
+        self._arm_ids = [self._joint[n] for n in ARM_JOINTS]
+        self._grip_ids = [self._joint[n] for n in GRIPPER_JOINTS]
+        self._wheel_ids = [self._joint[n] for n in WHEEL_JOINTS]
+        self._movable = [j for j in self._joint.values()
+                         if p.getJointInfo(self.robot, j)[2] != pybullet.JOINT_FIXED]
+        self._movable_names = [p.getJointInfo(self.robot, j)[1].decode() for j in self._movable]
+        self.reset_arm(np.zeros(len(ARM_JOINTS)))
+        self.set_gripper_target(0.0)
+        self.set_wheel_velocities(0.0, 0.0)
+        self.wheel_radius = 0.10
+        self.wheel_separation = 0.50
+
+    def close(self) -> None:
+        self._p.disconnect()
+
+    def step(self) -> None:
+        self._p.stepSimulation()
+        self.time += self.time_step
+
+    def joint_states(self) -> tuple[list[str], list[float], list[float]]:
+        """Names, positions and velocities of every movable joint (rad, m; rad/s, m/s)."""
+        states = self._p.getJointStates(self.robot, self._movable)
+        return self._movable_names, [s[0] for s in states], [s[1] for s in states]
+
+    # --- arm and gripper -------------------------------------------------------------------
+    def reset_arm(self, q: np.ndarray) -> None:
+        """Place the arm at q (rad) at rest and hold it there (start-up posture)."""
+        for j, qi in zip(self._arm_ids, q):
+            self._p.resetJointState(self.robot, j, float(qi))
+        self.set_arm_targets(np.asarray(q, float))
+
+    def set_arm_targets(self, q: np.ndarray, qd: np.ndarray | None = None) -> None:
+        """Track joint positions (rad) with feed-forward velocities (rad/s) through stiff motors."""
+        qd = np.zeros(len(q)) if qd is None else qd
+        forces = [self.limits[n].effort for n in ARM_JOINTS]
+        self._p.setJointMotorControlArray(
+            self.robot, self._arm_ids, pybullet.POSITION_CONTROL, targetPositions=list(q),
+            targetVelocities=list(qd), forces=forces,
+            positionGains=[0.3] * len(q), velocityGains=[1.0] * len(q))
+
+    def arm_positions(self) -> np.ndarray:
+        return np.array([s[0] for s in self._p.getJointStates(self.robot, self._arm_ids)])
+
+    def arm_velocities(self) -> np.ndarray:
+        return np.array([s[1] for s in self._p.getJointStates(self.robot, self._arm_ids)])
+
+    def set_gripper_target(self, finger: float) -> None:
+        """Both fingers to `finger` metres from the centre (the URDF mimic, enforced here)."""
+        lim = self.limits[GRIPPER_JOINTS[0]]
+        self._p.setJointMotorControlArray(
+            self.robot, self._grip_ids, pybullet.POSITION_CONTROL,
+            targetPositions=[finger, finger], forces=[lim.effort] * 2,
+            positionGains=[0.3] * 2)
+
+    def gripper_position(self) -> float:
+        return float(self._p.getJointState(self.robot, self._grip_ids[0])[0])
+
+    # --- base ------------------------------------------------------------------------------
+    def set_wheel_velocities(self, left: float, right: float) -> None:
+        """Wheel angular velocities (rad/s) through torque-limited velocity motors."""
+        eff = self.limits[WHEEL_JOINTS[0]].effort
+        self._p.setJointMotorControlArray(
+            self.robot, self._wheel_ids, pybullet.VELOCITY_CONTROL,
+            targetVelocities=[left, right], forces=[eff, eff])
+
+    def wheel_positions(self) -> np.ndarray:
+        """Unwrapped wheel angles (rad): PyBullet reports continuous joints without wrapping."""
+        return np.array([s[0] for s in self._p.getJointStates(self.robot, self._wheel_ids)])
+
+    def base_pose(self) -> tuple[float, float, float]:
+        """Ground truth (x, y, yaw) of base_link in the world frame (m, rad)."""
+        pos, orn = self._p.getBasePositionAndOrientation(self.robot)
+        yaw = self._p.getEulerFromQuaternion(orn)[2]
+        return float(pos[0]), float(pos[1]), float(yaw)
+
+    def base_twist(self) -> tuple[float, float]:
+        """Ground-truth forward speed (m/s) and yaw rate (rad/s)."""
+        lin, ang = self._p.getBaseVelocity(self.robot)
+        yaw = self.base_pose()[2]
+        return float(lin[0] * math.cos(yaw) + lin[1] * math.sin(yaw)), float(ang[2])
+
+    def bumper_in_contact(self) -> bool:
+        """True when the bumper touches anything but the floor."""
+        for c in self._p.getContactPoints(bodyA=self.robot, linkIndexA=self._link[BUMPER_LINK]):
+            if c[2] != self.plane:
+                return True
+        return False
+
+    def add_box(self, position: tuple[float, float, float], half_extents: tuple[float, float, float],
+                mass: float = 0.0) -> int:
+        """An obstacle (static when mass is 0), for contact tests and demos."""
+        p = self._p
+        shape = p.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half_extents)
+        return p.createMultiBody(mass, shape, -1, position)

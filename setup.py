@@ -1,0 +1,32 @@
+"""ament_python package acti_ros2: the nodes and their ROS-free cores."""
+from glob import glob
+
+from setuptools import find_packages, setup
+
+PACKAGE = "acti_ros2"
+
+setup(
+    name=PACKAGE,
+    version="0.1.0",
+    packages=find_packages(include=["acti_middle_node*", "vehicle_node*", "acti_bringup*",
+                                    "acti_motion*", "acti_sim*", "strolic*"]),
+    data_files=[
+        ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
+        (f"share/{PACKAGE}", ["package.xml"]),
+        (f"share/{PACKAGE}/urdf", glob("urdf/*.urdf")),
+        (f"share/{PACKAGE}/config", glob("config/*.yaml")),
+    ],
+    install_requires=["setuptools"],
+    zip_safe=False,
+    maintainer="acti_ros2 developers",
+    maintainer_email="dev@acti-ros2.example.org",
+    description="ACT manipulator ports, VehicleService and STROLIC on ROS 2 Jazzy",
+    license="Apache-2.0",
+    entry_points={
+        "console_scripts": [
+            "acti_middle_node = acti_middle_node.__main__:main",
+            "vehicle_node = vehicle_node.__main__:main",
+            "acti_robot = acti_bringup.__main__:main",
+        ],
+    },
+)
