@@ -17,6 +17,8 @@ setup(
         (f"share/{PACKAGE}/config", glob("config/*.yaml")),
     ],
     install_requires=["setuptools"],
+    tests_require=["pytest"],
+    extras_require={"test": ["pytest"]},
     zip_safe=False,
     maintainer="acti_ros2 developers",
     maintainer_email="dev@acti-ros2.example.org",

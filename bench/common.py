@@ -1,0 +1,52 @@
+"""Shared pieces of the benchmarks: DDS kept local, node processes, latency statistics."""
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+import time
+from contextlib import contextmanager
+from typing import Callable, Iterator
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+os.environ.setdefault("ROS_DOMAIN_ID", str(101 + os.getpid() % 60))
+os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+os.environ["FASTDDS_BUILTIN_TRANSPORTS"] = "UDPv4"
+
+from acti_bringup.harness import NodeProcess, RosClient  # noqa: E402
+
+
+@contextmanager
+def running(module: str, *params: str) -> Iterator[NodeProcess]:
+    with tempfile.TemporaryDirectory() as d:
+        node = NodeProcess(module, os.path.join(d, "node.log"), *params)
+        try:
+            yield node
+        finally:
+            node.stop()
+
+
+def latencies(fn: Callable[[], object], n: int, warmup: int = 30) -> np.ndarray:
+    """Wall seconds of n calls of fn after a warm-up."""
+    for _ in range(warmup):
+        fn()
+    out = np.empty(n)
+    for i in range(n):
+        t0 = time.perf_counter()
+        fn()
+        out[i] = time.perf_counter() - t0
+    return out
+
+
+def row(name: str, sample: np.ndarray, baseline: np.ndarray | None = None) -> str:
+    p50, p99 = np.percentile(sample, 50) * 1e3, np.percentile(sample, 99) * 1e3
+    text = f"{name:<34} p50 {p50:7.3f} ms   p99 {p99:7.3f} ms"
+    if baseline is not None:
+        b50, b99 = np.percentile(baseline, 50) * 1e3, np.percentile(baseline, 99) * 1e3
+        text += f"   ratio p50 {p50 / b50:5.2f}  p99 {p99 / b99:5.2f}"
+    return text
+
+
+__all__ = ["RosClient", "running", "latencies", "row"]

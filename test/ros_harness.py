@@ -1,0 +1,31 @@
+"""pytest fixtures over `acti_bringup.harness`: the client node and one node process per file."""
+from __future__ import annotations
+
+import signal
+
+import pytest
+
+from acti_bringup.harness import NodeProcess, RosClient, wait_until  # noqa: F401
+
+TEST_RATE = "real_time_factor:=4.0"
+
+
+@pytest.fixture(scope="session")
+def ros() -> RosClient:
+    client = RosClient()
+    yield client
+    client.close()
+
+
+def node_fixture(module: str, *params: str):
+    """A module-scoped fixture running one node process (4× real time) for the tests of a file."""
+    @pytest.fixture(scope="module")
+    def fixture(tmp_path_factory):
+        log = str(tmp_path_factory.mktemp(module) / "node.log")
+        node = NodeProcess(module, log, TEST_RATE, *params)
+        yield node
+        alive = node.alive()
+        code = node.stop()
+        assert alive, f"{module} died during the tests:\n{node.log()}"
+        assert code in (0, -signal.SIGINT), f"{module} exited with {code}:\n{node.log()}"
+    return fixture

@@ -1,0 +1,25 @@
+"""ROS-free fixtures: a real PyBullet world and executor, stepped by the test itself."""
+from __future__ import annotations
+
+import pytest
+
+from acti_motion.executor import MotionExecutor
+from acti_sim.world import World
+
+
+def run_until(executor: MotionExecutor, predicate, max_seconds: float) -> float:
+    """Step the simulation until predicate() holds; simulated seconds it took."""
+    t0 = executor.world.time
+    while not predicate():
+        if executor.world.time - t0 > max_seconds:
+            raise AssertionError(f"condition not reached in {max_seconds} simulated s")
+        executor.step()
+    return executor.world.time - t0
+
+
+@pytest.fixture
+def executor():
+    world = World()
+    ex = MotionExecutor(world, real_time_factor=0.0)
+    yield ex
+    world.close()

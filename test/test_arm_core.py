@@ -1,0 +1,104 @@
+"""ArmCore in the real simulation, without ROS: state word, checks, PTP accuracy, queue."""
+import math
+
+import numpy as np
+import pytest
+
+from acti_motion.arm import ArmConfig, ArmCore
+from acti_motion.replies import ReturnCode
+from sim_fixtures import executor, run_until  # noqa: F401
+
+TARGET = [10.0, 20.0, 30.0, -40.0, 50.0, 60.0, 70.0]
+
+
+@pytest.fixture
+def arm(executor):  # noqa: F811
+    return ArmCore(executor, ArmConfig(queue_size=3))
+
+
+def ready(arm):
+    assert arm.servo_on().ok and arm.set_speed_joint(100).ok
+
+
+def test_servo_off_refuses_motion(arm):
+    r = arm.move_ptp_joint_abs(TARGET)
+    assert r.code == ReturnCode.NOT_SV_ON_ERR and "servo" in r.comment
+
+
+def test_speed_starts_at_zero_and_refuses_motion(arm):
+    arm.servo_on()
+    r = arm.move_ptp_joint_abs(TARGET)
+    assert r.code == ReturnCode.STATUS_ERR and "set_speed_joint" in r.comment
+
+
+@pytest.mark.parametrize("ratio", [101, 1000, -1])
+def test_speed_ratio_out_of_range(arm, ratio):
+    r = arm.set_speed_joint(ratio)
+    assert r.code == ReturnCode.VALUE_ERR and "100" in r.comment
+    assert arm.speed_joint == 0
+
+
+@pytest.mark.parametrize("points, words", [
+    ([1.0] * 6, "7 values"), ([1.0] * 8, "7 values"), ([], "7 values"),
+    ([0, 0, 0, math.nan, 0, 0, 0], "finite"), ([0, math.inf, 0, 0, 0, 0, 0], "finite"),
+    ([0, 0, 0, 0, 0, 0, 400.0], "soft limit"),
+])
+def test_bad_joint_targets(arm, points, words):
+    ready(arm)
+    r = arm.move_ptp_joint_abs(points)
+    assert r.code == ReturnCode.VALUE_ERR and words in r.comment
+    assert arm.device.queue_length == 0
+
+
+def test_ptp_reaches_target_with_joints_arriving_together(arm, executor):  # noqa: F811
+    ready(arm)
+    assert arm.move_ptp_joint_abs(TARGET).ok
+    assert arm.state_word() & 0x03 == 0x03
+    start = np.degrees(executor.world.arm_positions())
+    way = np.subtract(TARGET, start)
+    moving = np.abs(way) > 1.0
+    remaining = []
+
+    def record():
+        q = np.degrees(executor.world.arm_positions())
+        remaining.append(((TARGET - q) / np.where(moving, way, 1.0))[moving])
+        return not arm.device.busy
+    run_until(executor, record, 10.0)
+    for _ in range(120):
+        executor.step()
+    pos = arm.get_feedback_pos_joint().values["pos"]
+    assert len(pos) == 8
+    assert np.max(np.abs(np.subtract(pos[:7], TARGET))) < 0.01
+    # synchronized: at every instant all joints have covered the same fraction of their way
+    spread = [np.ptp(r) for r in remaining]
+    assert max(spread) < 0.02
+    assert arm.state_word() == 0x01
+
+
+def test_full_queue_refuses_and_keeps_what_is_queued(arm):
+    ready(arm)
+    for i in range(3):
+        assert arm.move_ptp_joint_abs([i + 1.0] * 7).ok
+    assert arm.state_word() & 0x08
+    r = arm.move_ptp_joint_abs(TARGET)
+    assert r.code == ReturnCode.FULL_MOTION_QUEUE_ERR and "full" in r.comment
+    assert arm.device.queue_length == 3
+
+
+def test_move_to_where_it_is_finishes_at_once(arm, executor):  # noqa: F811
+    ready(arm)
+    here = list(ArmConfig().initial_joints_deg)
+    assert arm.move_ptp_joint_abs(here).ok
+    assert run_until(executor, lambda: not arm.device.busy, 1.0) < 0.02
+
+
+def test_servo_off_while_moving_stops_first(arm, executor):  # noqa: F811
+    ready(arm)
+    assert arm.move_ptp_joint_abs(TARGET).ok
+    for _ in range(120):
+        executor.step()
+    assert arm.servo_off().ok
+    assert arm.device.queue_length == 0
+    took = run_until(executor, lambda: not arm.device.busy, 2.0)
+    assert took <= arm.accel_time_joint + 0.01
+    assert arm.state_word() == 0
