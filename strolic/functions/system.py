@@ -1,0 +1,66 @@
+"""EF6C–EF75: identification, INIT, trace, and the exchange with the programming device."""
+from __future__ import annotations
+
+from ..codes import ACK_CODE, DATA_TYPES, Str
+from ..errors import ExceptionKind as K, fail
+from ..literals import format_value
+from ..values import encode_value
+
+VERSION_ID = b"STROLIC JIS B 8440-1994"      # the prefix EF6C requires, as printed
+SYSTEM_ID = b"acti_ros2 strolic 0.1 (Python STROLIC virtual machine, acti_ros2 project)"
+
+
+def verid(vm, proc) -> None:
+    proc.push(Str(VERSION_ID))
+
+
+def sysid(vm, proc) -> None:
+    proc.push(Str(SYSTEM_ID))
+
+
+def init(vm, proc) -> None:
+    """INIT: stacks, variables, heap, nesting, ε, trace, configuration, flags, channels and all
+    processes are reset; the program continues with the next code of the input stream."""
+    main = vm.main
+    vm.reset()
+    vm.processes = {0: main}
+    main.stack.clear()
+    main.returns.clear()
+    main.scopes[:] = [vm.globals]
+    main.event_buffer.clear()
+    main.frame = main.root
+    main.state = type(main.state).RUNNING
+    if proc is not main:
+        proc.state = type(proc.state).DONE
+
+
+def tron(vm, proc) -> None:
+    vm.trace = True
+
+
+def troff(vm, proc) -> None:
+    vm.trace = False
+
+
+def trace(vm, proc) -> None:
+    """TRACE: the item goes to the console in the text form when the trace flag is on."""
+    item = proc.pop()
+    if vm.trace:
+        vm.host.console(f"TRACE {format_value(item)}")
+
+
+def sync(vm, proc) -> None:
+    """SYNC: this VM is always in a normal state, so the answer is ACK."""
+    vm.host.send(ACK_CODE.to_bytes(2, "big"))
+
+
+def reply_code(vm, proc) -> None:
+    """ACK, NAK: replies to the host, never executed; received in a program they are ignored."""
+
+
+def result(vm, proc) -> None:
+    """RESULT: the value, as a tagged data code, on the output stream."""
+    value = proc.pop()
+    if not isinstance(value, DATA_TYPES):
+        raise fail(K.TYPE_MISMATCH, "RESULT sends data only")
+    vm.host.send(encode_value(value))
