@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from ..codes import ACK_CODE, DATA_TYPES, Str
 from ..errors import ExceptionKind as K, fail
-from ..literals import format_value
+from .. import literals
 from ..values import encode_value
 
 VERSION_ID = b"STROLIC JIS B 8440-1994"      # the prefix EF6C requires, as printed
@@ -46,7 +46,7 @@ def trace(vm, proc) -> None:
     """TRACE: the item goes to the console in the text form when the trace flag is on."""
     item = proc.pop()
     if vm.trace:
-        vm.host.console(f"TRACE {format_value(item)}")
+        vm.host.console(f"TRACE {literals.format_value(item)}")
 
 
 def sync(vm, proc) -> None:
