@@ -290,7 +290,7 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
     # ---- locks, events, channels, shared variables ------------------------------------------------------------------------------
     "LOCK": [("1 LOCK 1 UNLOCK", [F]), ("1 LOCK 1 LOCK", DEAD), ("0 LOCK", UNDEF),
              ("#f Fn{ 1 LOCK 2 ESIG 1 UNLOCK DROP END } STORE 1 LOCK #f 1 FXQT DROP "
-              "1 UNLOCK DROP 2 EWAIT 1 FDONE", [F, F][:1])],
+              "1 UNLOCK DROP 2 EWAIT 1 FDONE", [F])],
     "UNLOCK": [("1 LOCK 1 UNLOCK 1 UNLOCK", [F, T])],
     "EWAIT": [("1 ESIG 1 EWAIT 1", ["1"]), ("1 EWAIT", DEAD), ("1 ESIG 1 EWAIT 1 EWAIT", DEAD)],
     "EWAITA": [("1 ESIG 2 ESIG 1 2 2 EWAITA 5", ["5"]), ("1 ESIG 1 2 2 EWAITA", DEAD),
