@@ -10,9 +10,10 @@ import enum
 from dataclasses import dataclass
 
 from . import opcodes
-from .codes import (END_CODE, FUNCTION, INDIRECT, SUPPRESS, Function, FunctionCode, TagHead,
-                    UserCode, is_user_code)
-from .values import Reader, encode_head, encode_value, invalid, value_from_data
+from .codes import (END_CODE, FUNCTION, INDIRECT, SUPPRESS, Function, FunctionCode, UserCode,
+                    is_user_code)
+from .values import (Reader, encode_function_code, encode_item, encode_value, invalid,
+                     value_from_data)
 
 
 class CodeKind(enum.Enum):
@@ -96,19 +97,7 @@ def encode_code(code: Code) -> bytes:
         return encode_function_code(code.value)
     if code.kind is CodeKind.INDIRECT:
         return bytes([INDIRECT]) + encode_function_code(code.value)
-    return bytes([SUPPRESS]) + encode_suppressed(code.value)
-
-
-def encode_suppressed(item: object) -> bytes:
-    if isinstance(item, TagHead):
-        return encode_head(item)
-    if isinstance(item, (UserCode, FunctionCode)):
-        return encode_function_code(item.code)
-    raise invalid(f"{item!r} cannot be suppressed")
-
-
-def encode_function_code(code: int) -> bytes:
-    return code.to_bytes(4 if code > 0xFFFF else 2, "big")
+    return encode_item(code.value)
 
 
 def encode(codes: list[Code]) -> bytes:

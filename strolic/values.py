@@ -10,8 +10,8 @@ import struct
 
 from .codes import (ARRAY, FIXED_SIZE, FUNCTION, I1, I2, I4, INDIRECT, INT_FORMAT, INT_RANGE,
                     INTEGER_TAGS, LENGTH_TAGS, NUMERIC_TAGS, POSE, R4, R8, REAL_FORMAT, RECORD,
-                    STRING, SUPPRESS, TAG_NAMES, TRANSFORM, VECTOR, Array, Function, Num, Pose,
-                    Record, Str, TagHead, Trn, Vec)
+                    STRING, SUPPRESS, TAG_NAMES, TRANSFORM, VECTOR, Array, Function,
+                    FunctionCode, Num, Pose, Record, Str, TagHead, Trn, UserCode, Vec)
 from .errors import ExceptionKind as K, fail
 
 
@@ -154,6 +154,20 @@ def data_of(value: object) -> bytes:
 def encode_value(value: object) -> bytes:
     """A tagged data code."""
     return encode_head(head_of(value)) + data_of(value)
+
+
+def encode_item(item: object) -> bytes:
+    """Any stack item as code: data, or a suppressed user code, function code or tag (#…)."""
+    if isinstance(item, TagHead):
+        return bytes([SUPPRESS]) + encode_head(item)
+    if isinstance(item, (UserCode, FunctionCode)):
+        return bytes([SUPPRESS]) + encode_function_code(item.code)
+    return encode_value(item)
+
+
+def encode_function_code(code: int) -> bytes:
+    """2-byte codes, 4-byte extended user codes."""
+    return code.to_bytes(4 if code > 0xFFFF else 2, "big")
 
 
 def value_from_data(head: TagHead, data: bytes, offset: int = 0) -> object:

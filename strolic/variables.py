@@ -6,9 +6,9 @@ structured data stays a plain immutable value everywhere else.
 """
 from __future__ import annotations
 
-from .codes import LENGTH_TAGS, ARRAY, TagHead, type_name
+from .codes import ARRAY, DATA_TYPES, LENGTH_TAGS, TagHead, type_name
 from .errors import ExceptionKind as K, fail
-from .values import data_of, head_of, value_from_data
+from .values import data_of, encode_item, head_of, value_from_data
 
 
 class Binding:
@@ -34,8 +34,8 @@ class Binding:
         return self._value
 
     def assign(self, value) -> None:
-        """STORE/POP: the old area is released, the value gets its own (Reference 1 §6)."""
-        head_of(value)               # only data can be assigned
+        """STORE/POP: the old area is released, the value gets its own (Reference 1 §6).
+        Any stack item can be assigned, a suppressed user code too (for indirect references)."""
         self._value, self.head, self.area = value, None, None
 
     def allocate(self, head: TagHead, size: int) -> None:
@@ -63,7 +63,11 @@ class Binding:
     def size(self) -> int | None:
         if self.area is not None:
             return len(self.area)
-        return None if self._value is None else len(data_of(self._value))
+        if self._value is None:
+            return None
+        if isinstance(self._value, DATA_TYPES):
+            return len(data_of(self._value))
+        return len(encode_item(self._value))
 
     def release(self) -> None:
         self._value, self.head, self.area = None, None, None

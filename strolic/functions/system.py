@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from ..codes import ACK_CODE, DATA_TYPES, Str
 from ..errors import ExceptionKind as K, fail
+from ..process import State
 from .. import literals
 from ..values import encode_value
 
@@ -28,10 +29,12 @@ def init(vm, proc) -> None:
     main.returns.clear()
     main.scopes[:] = [vm.globals]
     main.event_buffer.clear()
+    if main.state is State.WAITING and main.frame is main.root:
+        main.root.pc += 1                 # the code main waited in is abandoned
     main.frame = main.root
-    main.state = type(main.state).RUNNING
+    main.state = State.RUNNING
     if proc is not main:
-        proc.state = type(proc.state).DONE
+        proc.state = State.DONE
 
 
 def tron(vm, proc) -> None:

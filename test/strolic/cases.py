@@ -176,7 +176,7 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
              ("#x PUSH", UNDEF), ("#%2000 PUSH", UNDEF), ("5 PUSH", TYPE)],
     "POP": [("5 #x POP x", ["5"]), ("5 #%2000 POP", UNDEF), ("5 6 POP", TYPE)],
     "STORE": [("#x 5 STORE x", ["5"]), ('#x 5 STORE #x "s" STORE x', ['"s"']),
-              ("#%2000 5 STORE", UNDEF), ("5 5 STORE", TYPE), ("#x #VAR STORE", TYPE)],
+              ("#%2000 5 STORE", UNDEF), ("5 5 STORE", TYPE), ("#x #y STORE x", ["#%1001"])],
     # ---- bytes and elements -------------------------------------------------------------------------------
     "EXTB": [('#x "ABCDEFGH" STORE #x 2 #St(3) EXTB', ['"CDE"']),
              ("#x I4:0x01020304 STORE #x 1 #I2 EXTB", ["515"]),
