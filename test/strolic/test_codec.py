@@ -128,7 +128,8 @@ def numbers():
 
 f32 = st.floats(width=32, allow_nan=False, allow_infinity=False)
 FUNCTION_CODES = [row.code for row in opcodes.TABLE if row.code != 0xEF5C]
-user_codes = st.one_of(st.integers(0x1000, 0xEAFF), st.integers(0xEB000000, 0xEBFFFFFF))
+user_codes = st.one_of(st.sampled_from([0x1000, 0x1001, 0x1002]), st.integers(0x1000, 0xEAFF),
+                       st.integers(0xEB000000, 0xEBFFFFFF))
 
 
 def data_values(codes):
