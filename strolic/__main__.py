@@ -8,7 +8,7 @@ from pathlib import Path
 from .codec import decode
 from .errors import StrolicError
 from .literals import format_value
-from .text import assemble, disassemble
+from .text import assemble, disassemble, format_code
 from .vm import VM
 
 TEXT_SUFFIXES = {".sasm", ".txt", ".strolic"}
@@ -30,8 +30,7 @@ def run(args: argparse.Namespace) -> int:
         return 1
     finally:
         for data in vm.host.output:
-            print("output:", " ".join(format_value(c.value) if c.kind.value == "data"
-                                      else data.hex() for c in decode(data)), file=sys.stderr)
+            print("output:", " ".join(format_code(code) for code in decode(data)), file=sys.stderr)
     if args.stack:
         for item in main.stack:
             print(format_value(item))
