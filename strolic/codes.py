@@ -193,10 +193,6 @@ class Array:
     element: TagHead
     data: bytes
 
-    def count(self) -> int:
-        size = self.element.element_size()
-        return len(self.data) // size if size else 0
-
 
 @dataclass(frozen=True, slots=True)
 class Function:
@@ -220,7 +216,7 @@ class Trn:
 
 @dataclass(frozen=True, slots=True)
 class Pose:
-    """Pose data (§15): a sequence of tagged numbers (the layout is documented in pose.py)."""
+    """Pose data (§15): a sequence of tagged numbers (this VM's layout: functions/geometry.py)."""
 
     elements: tuple[Num, ...]
 

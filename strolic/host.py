@@ -32,6 +32,9 @@ class Host:
     def sleep(self, seconds: float) -> None:
         time.sleep(max(seconds, 0.0))
 
+    def stop(self, error) -> None:
+        """Program execution stopped on an exception (§4.5): robot motion must stop too."""
+
     # robot and system functions without a handler in the opcode table
     def call(self, vm, proc, opcode) -> object:
         raise fail(K.UNDEFINED_DATA, f"{opcode.mnemonic} is not provided by this host")

@@ -12,7 +12,7 @@ from .codec import Code, CodeKind, decode, encode, encode_code
 from .codes import (ARRAY, I2, INDIRECT, LENGTH_TAGS, NUMERIC_TAGS, R8, REAL_TAGS, SUPPRESS,
                     TAGS_BY_NAME, Array, Function, FunctionCode, Num, Pose, Record, Str, TagHead,
                     Trn, UserCode, Vec, is_user_code, make_number, smallest_int, to_float32)
-from .errors import ExceptionKind as K, StrolicError, fail
+from .errors import ExceptionKind as K, StrolicError
 from .literals import format_user_code, format_value
 from .values import data_of, head_of, value_from_data
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 import struct
 
-from .codes import (ARRAY, FIXED_SIZE, FUNCTION, I1, I2, I4, INDIRECT, INT_FORMAT, INT_RANGE,
+from .codes import (ARRAY, FIXED_SIZE, FUNCTION, INDIRECT, INT_FORMAT, INT_RANGE,
                     INTEGER_TAGS, LENGTH_TAGS, NUMERIC_TAGS, POSE, R4, R8, REAL_FORMAT, RECORD,
                     STRING, SUPPRESS, TAG_NAMES, TRANSFORM, VECTOR, Array, Function,
                     FunctionCode, Num, Pose, Record, Str, TagHead, Trn, UserCode, Vec)
@@ -202,11 +202,6 @@ def value_from_data(head: TagHead, data: bytes, offset: int = 0) -> object:
             elements.append(reader.number())
         return Pose(tuple(elements))
     raise invalid(f"{TAG_NAMES.get(tag, hex(tag))} has no data", offset)
-
-
-def head_size(head: TagHead) -> int:
-    """Bytes a head occupies when written."""
-    return len(encode_head(head))
 
 
 def array_elements(array: Array) -> list:

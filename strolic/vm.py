@@ -86,12 +86,16 @@ class VM:
         self.processes = {0: main}
         self.budget = budget
         self.executed = 0
-        while main.state is not State.DONE:
-            proc = self._pick()
-            if proc is None:
-                self._idle()
-                continue
-            self._execute(proc, SLICE)
+        try:
+            while main.state is not State.DONE:
+                proc = self._pick()
+                if proc is None:
+                    self._idle()
+                    continue
+                self._execute(proc, SLICE)
+        except StrolicError as error:
+            self.host.stop(error)
+            raise
         return main
 
     def _eligible(self, proc: Process, now: float | None) -> bool:

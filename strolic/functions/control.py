@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from ..codes import VAR_CODE, Function, FunctionCode, UserCode, user_key
 from ..errors import ExceptionKind as K, fail
+from ..process import PUSH
 from ..variables import Scope, declare, find, find_at_level, free as free_binding
 from .args import expect, pop_count, pop_num, pop_user
 
@@ -80,7 +81,7 @@ def fdef(vm, proc) -> None:
     target = pop_user(proc)
     frame = proc.frame
     following = frame.codes[frame.pc][1] if frame.pc < len(frame.codes) else None
-    if frame.pc >= len(frame.codes) or frame.codes[frame.pc][0] != 0 \
+    if frame.pc >= len(frame.codes) or frame.codes[frame.pc][0] != PUSH \
             or not isinstance(following, Function):
         raise fail(K.TYPE_MISMATCH, "FDEF must be followed by function data")
     frame.pc += 1

@@ -6,11 +6,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from conftest import RecordingHost, error_of, execute, stack_of
-from strolic.codec import Code, CodeKind, encode
+from strolic.codec import encode
 from strolic.codes import Num, I2
 from strolic.errors import ExceptionKind as K, StrolicError
-from strolic.host import Host
-from strolic.process import State
 from strolic.text import assemble
 from strolic.vm import VM
 from test_codec import program_codes
@@ -93,6 +91,22 @@ def test_robot_functions_go_to_the_host() -> None:
             proc.push(Num(I2, 0))       # the error flag of JSPEED
 
     assert stack_of("50 JSPEED", host=Robot()) == ["I2:0"]
+
+
+def test_robot_exceptions_raised_by_the_host_stop_the_program_and_the_robot() -> None:
+    class Robot(RecordingHost):
+        stopped = None
+
+        def call(self, vm, proc, opcode):
+            raise StrolicError(K.EMERGENCY_STOP, "emergency stop button")
+
+        def stop(self, error):
+            self.stopped = error.kind
+
+    robot = Robot()
+    error = error_of("Trn(0 0 0 1 0 0 0 1 0 0 0 1) PNT ALMOVE 1", host=robot)
+    assert (error.kind, error.function, robot.stopped) == (K.EMERGENCY_STOP, "ALMOVE",
+                                                           K.EMERGENCY_STOP)
 
 
 def test_tasks_go_to_the_host() -> None:
