@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from . import opcodes
 from .codes import (END_CODE, FUNCTION, INDIRECT, SUPPRESS, Function, FunctionCode, UserCode,
                     is_user_code)
-from .values import (Reader, encode_function_code, encode_item, encode_value, invalid,
+from .values import (MAX_NESTING, Reader, encode_function_code, encode_item, encode_value, invalid,
                      value_from_data)
 
 
@@ -44,7 +44,7 @@ def read_function_code(reader: Reader, first: int) -> int:
     return code
 
 
-def read_code(reader: Reader) -> Code:
+def read_code(reader: Reader, depth: int) -> Code:
     start = reader.offset
     first = reader.byte()
     if first == SUPPRESS:
@@ -68,17 +68,20 @@ def read_code(reader: Reader) -> Code:
         data_offset = reader.offset
         value = value_from_data(head, reader.take(head.element_size()), data_offset)
         if head.tag == FUNCTION:
-            decode(value.body, data_offset, function_body=True)
+            if depth >= MAX_NESTING:
+                raise invalid(f"function data nested deeper than {MAX_NESTING}", start)
+            decode(value.body, data_offset, function_body=True, depth=depth + 1)
         return Code(CodeKind.DATA, value, start, reader.offset - start)
     return Code(CodeKind.CALL, read_function_code(reader, first), start, reader.offset - start)
 
 
-def decode(data: bytes, base: int = 0, *, function_body: bool = False) -> list[Code]:
+def decode(data: bytes, base: int = 0, *, function_body: bool = False,
+           depth: int = 0) -> list[Code]:
     """All codes of ``data``; offsets are counted from ``base``. Raises StrolicError only."""
     reader = Reader(bytes(data), base)
     codes = []
     while not reader.at_end():
-        codes.append(read_code(reader))
+        codes.append(read_code(reader, depth))
     if function_body and (not codes or codes[-1].kind is not CodeKind.CALL
                           or codes[-1].value != END_CODE):
         raise invalid("function data must end with END", base)

@@ -14,7 +14,7 @@ from .codes import (ARRAY, I2, INDIRECT, LENGTH_TAGS, NUMERIC_TAGS, R8, REAL_TAG
                     Trn, UserCode, Vec, is_user_code, make_number, smallest_int, to_float32)
 from .errors import ExceptionKind as K, StrolicError
 from .literals import format_user_code, format_value
-from .values import data_of, head_of, value_from_data
+from .values import MAX_NESTING, data_of, head_of, value_from_data
 
 TOKEN = re.compile(r'''(?P<skip>[\s,]+|;[^\n]*)
                      |(?P<string>"(?:[^"\\]|\\.)*")
@@ -53,6 +53,7 @@ class Assembler:
         self.tokens = tokenize(text)
         self.pos = 0
         self.names: dict[str, int] = {}
+        self.depth = 0
 
     # ---- token access --------------------------------------------------------------------
     def peek(self) -> tuple[str, str, int] | None:
@@ -121,7 +122,11 @@ class Assembler:
             return Code(CodeKind.INDIRECT, self.user_code(word[1:]), 0, 0)
         if kind == "word" and word == "Fn" and self.peek() and self.peek()[1] == "{":
             self.pos += 1
+            self.depth += 1
+            if self.depth > MAX_NESTING:
+                raise self.error(f"function data nested deeper than {MAX_NESTING}")
             body = encode(self.program("}"))
+            self.depth -= 1
             return Code(CodeKind.DATA, Function(body), 0, 0)
         if kind == "word" and (word in opcodes.BY_MNEMONIC or word in self.names
                                or word.startswith("%")):
@@ -153,14 +158,16 @@ class Assembler:
         return UserCode(self.user_code(word))
 
     # ---- data ------------------------------------------------------------------------------------
-    def head(self, name: str) -> TagHead:
+    def head(self, name: str, depth: int = 0) -> TagHead:
         tag = TAGS_BY_NAME.get(name)
+        if depth > MAX_NESTING:
+            raise self.error(f"arrays nested deeper than {MAX_NESTING}")
         if tag is None:
             raise self.error(f"{name!r} is not a tag")
         if tag == ARRAY:
             self.expect("(")
             length = self.integer(self.next()[1])
-            element = self.head(self.next()[1])
+            element = self.head(self.next()[1], depth + 1)
             self.expect(")")
             if element.tag in (SUPPRESS, INDIRECT):
                 raise self.error("array elements must be data")

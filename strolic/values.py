@@ -45,6 +45,9 @@ def decode_number_data(tag: int, data: bytes, offset: int = 0) -> Num:
     return Num(tag, value)
 
 
+MAX_NESTING = 64     # array heads in array heads, function data in function data
+
+
 class Reader:
     """A cursor over code bytes; ``base`` turns positions into offsets of the whole program."""
 
@@ -90,9 +93,11 @@ class Reader:
             raise invalid(f"length {value} not in its smallest integer form", start)
         return value
 
-    def head(self, first: int) -> TagHead:
+    def head(self, first: int, depth: int = 0) -> TagHead:
         """The data-tag-part after its first byte ``first`` (§6.1)."""
         start = self.offset - 1
+        if depth > MAX_NESTING:
+            raise invalid(f"arrays nested deeper than {MAX_NESTING}", start)
         tag = first
         if first == 0xFF:
             tag = 0xFF00 | self.byte()
@@ -101,7 +106,7 @@ class Reader:
         if tag == ARRAY:
             length = self.length()
             element_first = self.byte()
-            element = self.head(element_first)
+            element = self.head(element_first, depth + 1)
             if element.tag in (SUPPRESS, INDIRECT):
                 raise invalid("array elements must be data", start)
             return TagHead(tag, length, element)

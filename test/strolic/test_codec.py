@@ -12,7 +12,7 @@ from strolic.codes import (I1, I2, I4, R4, R8, Array, Function, FunctionCode, Nu
                            Str, TagHead, Trn, UserCode, Vec)
 from strolic.errors import ExceptionKind as K, StrolicError
 from strolic.text import assemble, disassemble
-from strolic.values import encode_value
+from strolic.values import encode_length, encode_value
 
 FUZZ = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
@@ -183,3 +183,18 @@ def test_random_bytes_raise_only_strolic_errors(data: bytes) -> None:
     "10", "EF", "5C", "EB", "00", "FF01", "FF02", "FF04", "EF5C", "1000")]), max_size=30))
 def test_tag_shaped_bytes_raise_only_strolic_errors(pieces) -> None:
     test_random_bytes_raise_only_strolic_errors.hypothesis.inner_test(b"".join(pieces))
+
+
+def test_deep_nesting_is_an_invalid_code_not_a_crash() -> None:
+    deep_array_head = bytes.fromhex("F0") + bytes.fromhex("F9F100") * 2000 + bytes.fromhex("F2")
+    body = bytes.fromhex("EF5C")
+    for _ in range(200):
+        body = bytes.fromhex("FD") + encode_length(len(body)) + body + bytes.fromhex("EF5C")
+    for program in (deep_array_head, body):
+        with pytest.raises(StrolicError) as caught:
+            decode(program)
+        assert caught.value.kind is K.INVALID_CODE and "deeper" in caught.value.detail
+    with pytest.raises(StrolicError):
+        assemble("Fn{ " * 2000)
+    with pytest.raises(StrolicError):
+        assemble("#" + "Ar(0, " * 2000)
