@@ -40,9 +40,9 @@ class Frame:
     def jump(self, offset: int, index: int) -> None:
         """Move ``offset`` bytes from the end of instruction ``index`` (§ BRA, BRF, BRT, BAL)."""
         _, _, start, size = self.codes[index]
-        target = start - self.origin + size + offset
+        target = start + size + offset
         if self._positions is None:
-            self._positions = {code[2] - self.origin: i for i, code in enumerate(self.codes)}
+            self._positions = {code[2]: i for i, code in enumerate(self.codes)}
         if target not in self._positions:
             raise fail(K.BRANCH_OUT_OF_FUNCTION,
                        f"target {target} is not a code of this function body")

@@ -1,8 +1,8 @@
 """The intermediate-code machine of Reference 1: compiling codes, scheduler, dispatch.
 
-Processes are scheduled
-cooperatively: the runnable process with the smallest priority number runs for a slice;
-a blocking function (LOCK, EWAIT, CHIN …) returns ``WAIT`` and is retried when something changed.
+Processes are scheduled cooperatively: the runnable process with the smallest priority number
+runs for a slice; a blocking function (LOCK, EWAIT, CHIN …) returns ``WAIT`` and is retried
+when something changed.
 """
 from __future__ import annotations
 
@@ -53,26 +53,29 @@ class VM:
         return [self.globals]
 
     # ---- compiling codes into instructions -------------------------------------------------
-    def compile(self, codes: list) -> list:
-        """Instructions (op, argument, absolute offset, size) from decoded codes."""
+    def compile(self, codes: list, origin: int = 0) -> list:
+        """Instructions (op, argument, offset in the body, size) from decoded codes."""
         instructions = []
         for code in codes:
+            offset = code.offset - origin
             if code.kind is CodeKind.CALL:
                 if is_user_code(code.value):
-                    instruction = (USER, user_key(code.value), code.offset, code.size)
+                    instruction = (USER, user_key(code.value), offset, code.size)
                 else:
-                    instruction = (BUILTIN, opcodes.BY_CODE[code.value], code.offset, code.size)
+                    instruction = (BUILTIN, opcodes.BY_CODE[code.value], offset, code.size)
             elif code.kind is CodeKind.INDIRECT:
-                instruction = (INDIRECT, user_key(code.value), code.offset, code.size)
+                instruction = (INDIRECT, user_key(code.value), offset, code.size)
             else:
-                instruction = (PUSH, code.value, code.offset, code.size)
+                instruction = (PUSH, code.value, offset, code.size)
             instructions.append(instruction)
         return instructions
 
     def function_frame(self, function: Function, name: str) -> Frame:
+        """A frame for a function body; bodies are compiled once (offsets relative to the body)."""
         codes = self._compiled.get(function.body)
         if codes is None:
-            codes = self._compiled[function.body] = self.compile(decode_function(function))
+            codes = self._compiled[function.body] = self.compile(decode_function(function),
+                                                                 function.origin or 0)
         return Frame(codes, function.origin or 0, function, name)
 
     # ---- running -------------------------------------------------------------------------------
@@ -129,9 +132,8 @@ class VM:
         if not due:
             frame = self.main.frame
             code = frame.codes[frame.pc] if frame.pc < len(frame.codes) else None
-            raise fail(K.DEADLOCK, "every process waits and nothing can wake them").located(
-                code[1].mnemonic if code and code[0] == BUILTIN else None,
-                code[2] if code else None)
+            raise self._locate(fail(K.DEADLOCK, "every process waits and nothing can wake them"),
+                               self.main, frame, code)
         self.host.sleep(min(due) - self.host.now())
 
     def finish(self, proc: Process) -> None:
@@ -187,26 +189,28 @@ class VM:
                     frame = proc.frame
                     codes = frame.codes
         except StrolicError as error:
-            raise self._locate(error, proc, instruction)
+            raise self._locate(error, proc, frame, instruction)
         except (ArithmeticError, ValueError, TypeError, IndexError, KeyError,
                 RecursionError, MemoryError) as error:
             raise self._locate(fail(K.COMPUTER_ERROR, f"{type(error).__name__}: {error}"),
-                               proc, instruction) from error
+                               proc, frame, instruction) from error
         finally:
             self.executed += count
             proc.last_run = self.executed
 
-    def _locate(self, error: StrolicError, proc: Process, instruction) -> StrolicError:
+    def _locate(self, error: StrolicError, proc: Process, frame: Frame,
+                instruction) -> StrolicError:
+        """Name the failing code and its byte offset in the program (§4.5 report)."""
         if instruction is None:
             return error
         op, argument, offset, _ = instruction
         name = (argument.mnemonic if op == BUILTIN else f"%{argument:04X}" if op == USER
                 else f"@%{argument:04X}" if op == INDIRECT else "data")
-        if proc.frame.function is not None:
-            name += f" (in function {proc.frame.name})"
+        if frame.function is not None:
+            name += f" (in function {frame.name})"
         if proc.number:
             name += f" (process {proc.number})"
-        return error.located(name, offset)
+        return error.located(name, frame.origin + offset)
 
     # ---- frames and calls -------------------------------------------------------------------------
     def fall_off(self, proc: Process) -> None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
-from conftest import RecordingHost, error_of, execute, stack_of
+from conftest import PRELUDE, RecordingHost, error_of, execute, stack_of
 from strolic.codec import encode
 from strolic.codes import Num, I2
 from strolic.errors import ExceptionKind as K, StrolicError
@@ -172,3 +172,15 @@ def test_random_programs_stop_only_with_strolic_exceptions(codes, declared) -> N
         VM(max_stack=1000, max_return_depth=100).run(prelude + encode(codes), budget=5000)
     except StrolicError as error:
         assert error.kind is not K.COMPUTER_ERROR, error.report()
+
+
+def test_equal_function_bodies_at_different_offsets_branch_correctly() -> None:
+    body = "Fn{ 0 >a BRF 1 a: 2 END }"
+    assert stack_of(f"#f {body} STORE 5 5 5 #g {body} STORE f g") == ["5", "5", "5", "2", "2"]
+    text = "#f Fn{ 1 0 DIV END } STORE 1 2 3 #g Fn{ 1 0 DIV END } STORE f"
+    program = assemble(PRELUDE + text)
+    first_div = program.index(bytes.fromhex("EF03"))
+    with pytest.raises(StrolicError) as caught:
+        VM().run(program)
+    assert caught.value.function == "DIV (in function %1002)"
+    assert caught.value.offset == first_div
