@@ -177,10 +177,10 @@ def test_random_programs_stop_only_with_strolic_exceptions(codes, declared) -> N
 def test_equal_function_bodies_at_different_offsets_branch_correctly() -> None:
     body = "Fn{ 0 >a BRF 1 a: 2 END }"
     assert stack_of(f"#f {body} STORE 5 5 5 #g {body} STORE f g") == ["5", "5", "5", "2", "2"]
-    text = "#f Fn{ 1 0 DIV END } STORE 1 2 3 #g Fn{ 1 0 DIV END } STORE f"
+    text = "#f Fn{ 1 EXCH IDIV END } STORE 1 2 3 #g Fn{ 1 EXCH IDIV END } STORE 1 f 0 g"
     program = assemble(PRELUDE + text)
-    first_div = program.index(bytes.fromhex("EF03"))
+    second_idiv = program.rindex(bytes.fromhex("EF06"))
     with pytest.raises(StrolicError) as caught:
         VM().run(program)
-    assert caught.value.function == "DIV (in function %1002)"
-    assert caught.value.offset == first_div
+    assert caught.value.function == "IDIV (in function %1003)"
+    assert caught.value.offset == second_idiv
