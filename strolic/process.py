@@ -14,6 +14,8 @@ from .variables import Scope
 PUSH, BUILTIN, USER, INDIRECT = range(4)
 WAIT = object()          # returned by a handler that must wait; the VM retries it later
 DEFAULT_PRIORITY = 100
+RETRY = -1               # ``blocked_at`` of a process that should look at its condition again
+CYCLE_WAIT = -2          # ``blocked_at`` of a cyclic process waiting for its next start
 
 
 class State(enum.IntEnum):
@@ -64,7 +66,7 @@ class Process:
         self.priority = DEFAULT_PRIORITY
         self.period = 0.0                  # cyclic start interval in seconds (0: none)
         self.next_start = 0.0
-        self.blocked_at = -1               # VM generation when it last had to wait
+        self.blocked_at = RETRY            # VM generation when it last had to wait
         self.last_run = 0
         self.event_buffer: list[int] = []
         self.push = self.stack.append
@@ -86,4 +88,5 @@ class Process:
         self.root.pc = 0
         self.returns.clear()
         self.stack.clear()
+        del self.scopes[1:]
         self.state = State.RUNNING

@@ -11,7 +11,8 @@ from .codec import CodeKind, decode, decode_function
 from .codes import Function, Num, UserCode, is_user_code, user_code_of, user_key
 from .errors import ExceptionKind as K, StrolicError, fail
 from .host import Host
-from .process import BUILTIN, INDIRECT, PUSH, USER, WAIT, Frame, Process, State
+from .process import (BUILTIN, CYCLE_WAIT, INDIRECT, PUSH, USER, WAIT, Frame, Process,
+                      State)
 from .variables import Scope, find
 
 SLICE = 200              # instructions a process runs before the scheduler looks again
@@ -105,7 +106,7 @@ class VM:
         if proc.state is State.RUNNING:
             return True
         if proc.state is State.WAITING:
-            if proc.period and proc.blocked_at == -2:
+            if proc.period and proc.blocked_at == CYCLE_WAIT:
                 return now is not None and now >= proc.next_start
             return proc.blocked_at != self.generation
         return False
@@ -119,7 +120,7 @@ class VM:
                                               < (best.priority, best.last_run)):
                 best = proc
         if best is not None and best.state is State.WAITING:
-            if best.blocked_at == -2:
+            if best.blocked_at == CYCLE_WAIT:
                 best.restart()
             else:
                 best.state = State.RUNNING
@@ -128,7 +129,7 @@ class VM:
     def _idle(self) -> None:
         """Nothing can run: sleep until a cyclic start is due, or report the deadlock."""
         due = [p.next_start for p in self.processes.values()
-               if p.state is State.WAITING and p.blocked_at == -2]
+               if p.state is State.WAITING and p.blocked_at == CYCLE_WAIT]
         if not due:
             frame = self.main.frame
             code = frame.codes[frame.pc] if frame.pc < len(frame.codes) else None
@@ -141,7 +142,7 @@ class VM:
         self.changed()
         if proc.period:
             proc.state = State.WAITING
-            proc.blocked_at = -2
+            proc.blocked_at = CYCLE_WAIT
             now = self.host.now()
             while proc.next_start <= now:
                 proc.next_start += proc.period

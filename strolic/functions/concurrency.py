@@ -9,7 +9,7 @@ from __future__ import annotations
 from ..codes import I2, Function, Num, UserCode, user_key
 from ..errors import ExceptionKind as K, fail
 from ..variables import find
-from ..process import WAIT, Process, State
+from ..process import CYCLE_WAIT, RETRY, WAIT, Process, State
 from .args import expect, integer_value, pop_count, pop_many, pop_num, pop_user
 
 
@@ -93,8 +93,8 @@ def fresume(vm, proc) -> None:
         proc.push(Num(I2, 1))
         return
     target.state = target.suspended_from
-    if target.blocked_at != -2:
-        target.blocked_at = -1           # a waiting process looks at its condition again
+    if target.blocked_at != CYCLE_WAIT:
+        target.blocked_at = RETRY
     vm.changed()
     proc.push(Num(I2, 0))
 
