@@ -47,7 +47,7 @@ def tokenize(text: str) -> list[tuple[str, str, int]]:
 
 
 class Assembler:
-    """Recursive descent over the tokens; produces codes with their byte offsets."""
+    """Recursive descent over the tokens; produces codes (their offsets come from decoding)."""
 
     def __init__(self, text: str) -> None:
         self.tokens = tokenize(text)
