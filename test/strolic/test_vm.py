@@ -184,3 +184,22 @@ def test_equal_function_bodies_at_different_offsets_branch_correctly() -> None:
         VM().run(program)
     assert caught.value.function == "IDIV (in function %1003)"
     assert caught.value.offset == second_idiv
+
+
+def test_cyclic_process_runs_every_period_on_the_host_clock() -> None:
+    class Clock(RecordingHost):
+        time = 0.0
+
+        def now(self):
+            return self.time
+
+        def sleep(self, seconds):
+            self.time += seconds
+
+    host = Clock()
+    program = ("#x 0 STORE #f Fn{ #x x INC STORE x RESULT x 3 GEQ >s BRT END s: 2 ESIG END } "
+               "STORE #f 1 FXQT DROP 1 100 FCYCLE DROP 2 EWAIT 1 0 FCYCLE x")
+    _, main = execute(program, host=host)
+    assert [item.value for item in main.stack] == [2, 3]     # waiting for its next start
+    assert host.output == [bytes([0xF1, n]) for n in (1, 2, 3)]
+    assert host.time == pytest.approx(0.2)      # started at 0, then at 0.1 and 0.2
