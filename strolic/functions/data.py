@@ -6,7 +6,7 @@ stay inside the area of the user code (which ALLOC may make larger than the valu
 """
 from __future__ import annotations
 
-from ..codes import (ARRAY, I1, I2, I4, INDIRECT, INT_RANGE, NUMERIC_TAGS, R4, STRING, SUPPRESS,
+from ..codes import (ARRAY, DATA_TYPES, I1, I2, I4, INDIRECT, INT_RANGE, NUMERIC_TAGS, R4, STRING, SUPPRESS,
                      TRANSFORM, VECTOR, Array, Num, TagHead, UserCode, make_number,
                      round_half_away, smallest_int, type_name, user_code_of, user_key,
                      wrap_int)
@@ -94,7 +94,8 @@ def _element_layout(binding) -> tuple[TagHead, int, bool]:
         return TagHead(I1), 1, False
     if head.tag in (VECTOR, TRANSFORM):
         return TagHead(R4), 4, False
-    raise fail(K.TYPE_MISMATCH, f"EXTE/EMBE need Ar, St, Vec or Trn, not {type_name(binding.value())}")
+    raise fail(K.TYPE_MISMATCH,
+               f"EXTE/EMBE need Ar, St, Vec or Trn, not {type_name(binding.value())}")
 
 
 def exte(vm, proc) -> None:
@@ -139,9 +140,7 @@ def convert_element(value, head: TagHead):
         if low is not None and not low <= number <= high:
             raise fail(K.TYPE_MISMATCH, f"{number} cannot be converted to the element type")
         return make_number(head.tag, number)
-    if head.tag in (VECTOR, TRANSFORM) or head_of(value) == head:
-        if head_of(value) != head:
-            raise fail(K.TYPE_MISMATCH, f"{type_name(value)} cannot become the element type")
+    if isinstance(value, DATA_TYPES) and head_of(value) == head:
         return value
     raise fail(K.TYPE_MISMATCH, f"{type_name(value)} cannot become the element type")
 
