@@ -104,18 +104,18 @@ def txqt(vm, proc) -> None:
     proc.push(Num(I2, vm.host.start_task(pop_count(proc))))
 
 
-def tprecd(vm, proc) -> None:
-    priority = pop_count(proc)
-    number = pop_count(proc)
-    vm.host.set_task_priority(number, priority)
-    proc.push(Num(I2, vm.host.task_state(number)))
+def task_setting(setter: str):
+    """TPRECD (priority), TCYCLE (period in ms): a b → the state of task a."""
+    def handler(vm, proc) -> None:
+        value = pop_count(proc)
+        number = pop_count(proc)
+        getattr(vm.host, setter)(number, value)
+        proc.push(Num(I2, vm.host.task_state(number)))
+    return handler
 
 
-def tcycle(vm, proc) -> None:
-    period = pop_count(proc)
-    number = pop_count(proc)
-    vm.host.set_task_cycle(number, period)
-    proc.push(Num(I2, vm.host.task_state(number)))
+tprecd = task_setting("set_task_priority")
+tcycle = task_setting("set_task_cycle")
 
 
 def tdone(vm, proc) -> None:
