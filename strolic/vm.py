@@ -31,6 +31,8 @@ class VM:
         self.max_nesting = max_nesting
         self.heap_limit = heap_limit
         self._compiled: dict[bytes, list] = {}
+        self.generation = 0                # bumped whenever waiting processes may proceed
+        self.executed = 0                  # instructions of the current run (budget)
         self.reset()
 
     # ---- state ----------------------------------------------------------------------------
@@ -44,8 +46,6 @@ class VM:
         self.flags: set[int] = set()       # event flags that are on
         self.channels: dict[int, object] = {}
         self.processes: dict[int, Process] = {}
-        self.generation = 0                # bumped whenever waiting processes may proceed
-        self.executed = 0
 
     def changed(self) -> None:
         self.generation += 1

@@ -254,7 +254,8 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
     # ---- identification, INIT, trace, exchange --------------------------------------------------------------------
     "VERID": [("VERID", ['"STROLIC JIS B 8440-1994"'])],
     "SYSID": [("SYSID LNG 0 GT", [T])],
-    "INIT": [("1 2 #x 5 STORE INIT 3", ["3"]), ("INIT x", UNDEF), ("0.5 SEPS INIT EPS", ["1e-06"])],
+    "INIT": [("1 2 #x 5 STORE INIT 3", ["3"]), ("INIT x", UNDEF), ("0.5 SEPS INIT EPS", ["1e-06"]),
+             ("#f Fn{ 7 INIT 8 END } STORE 1 f 9", ["9"])],
     "TRON": [("TRON 5 TRACE", [])],
     "TROFF": [("TRON TROFF 5 TRACE", [])],
     "TRACE": [("5 TRACE 1", ["1"]), ("TRACE", UNDER)],
