@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 from .errors import ExceptionKind as K, fail
 
-# ---- tags (Table 2, Table 3) -------------------------------------------------------------------
+# ---- tags (Table 2, Table 3) --------------------------------------------------------------------
 SUPPRESS, I1, I2, I4, R4, R8, INDIRECT = 0xF0, 0xF1, 0xF2, 0xF4, 0xF5, 0xF6, 0xF7
 ARRAY, STRING, RECORD, FUNCTION = 0xF9, 0xFA, 0xFB, 0xFD
 VECTOR, TRANSFORM, POSE = 0xFF01, 0xFF02, 0xFF04
@@ -32,7 +32,7 @@ INT_BITS = {I1: 8, I2: 16, I4: 32}
 INT_FORMAT = {I1: ">b", I2: ">h", I4: ">i"}
 REAL_FORMAT = {R4: ">f", R8: ">d"}
 
-# ---- code areas (§16, §17, Annex 1 §2) ---------------------------------------------------------
+# ---- code areas (§16, §17, Annex 1 §2) ----------------------------------------------------------
 END_CODE = 0xEF5C
 VAR_CODE = 0xEF63
 ACK_CODE, NAK_CODE = 0xEF73, 0xEF74
@@ -42,7 +42,7 @@ EXT_ALIAS_MIN, EXT_ALIAS_MAX = 0xEB00_1000, 0xEB00_EAFF
 
 
 def is_user_code(code: int) -> bool:
-    """2-byte user codes 1000–EAFF and the EB-prefixed extended codes this implementation decodes."""
+    """2-byte user codes 1000–EAFF and the EB-prefixed extended codes (the ones decoded here)."""
     return USER_MIN <= code <= USER_MAX or EXT_USER_MIN <= code <= EXT_USER_MAX
 
 
@@ -62,7 +62,7 @@ def user_key(code: int) -> int:
     return code & 0xFFFF if EXT_ALIAS_MIN <= code <= EXT_ALIAS_MAX else code
 
 
-# ---- numbers -----------------------------------------------------------------------------------
+# ---- numbers ------------------------------------------------------------------------------------
 class Num:
     """A tagged number: ``tag`` is I1, I2, I4, R4 or R8 (their order is the §5 strength order)."""
 
@@ -156,7 +156,7 @@ def logical(flag: bool) -> Num:
     return TRUE if flag else FALSE
 
 
-# ---- tag heads (the `data-tag-part` of §6.1) ---------------------------------------------------
+# ---- tag heads (the `data-tag-part` of §6.1) ----------------------------------------------------
 @dataclass(frozen=True, slots=True)
 class TagHead:
     """A tag with its length (St, Rd, Fn, Pm, Ar) and, for Ar, the element head.
@@ -177,7 +177,7 @@ class TagHead:
         raise fail(K.TYPE_MISMATCH, f"{TAG_NAMES[self.tag]} is not a data type")
 
 
-# ---- values --------------------------------------------------------------------------------------
+# ---- values -------------------------------------------------------------------------------------
 @dataclass(frozen=True, slots=True)
 class Str:
     data: bytes

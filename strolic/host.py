@@ -12,7 +12,7 @@ from .errors import ExceptionKind as K, fail
 
 
 class Host:
-    """A host with no robot and no OS tasks; it keeps what the VM sends to the programming device."""
+    """A host without robot or OS tasks; it keeps what the VM sends to the programming device."""
 
     def __init__(self) -> None:
         self.output: list[bytes] = []

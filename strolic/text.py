@@ -78,7 +78,7 @@ class Assembler:
 
     # ---- programs ------------------------------------------------------------------------------
     def program(self, closing: str | None = None) -> list[Code]:
-        """Codes up to ``closing``; labels (``name:``) and references (``>name``) are local to it."""
+        """Codes up to ``closing``; labels (``name:``) and references (``>name``) are local."""
         codes: list[Code] = []
         labels: dict[str, int] = {}
         references: list[tuple[int, str, int]] = []
@@ -296,7 +296,7 @@ def assemble(text: str) -> bytes:
     return program
 
 
-# ---- disassembler ---------------------------------------------------------------------------------
+# ---- disassembler -------------------------------------------------------------------------------
 def format_code(code: Code) -> str:
     if code.kind is CodeKind.CALL:
         row = opcodes.BY_CODE.get(code.value)

@@ -21,7 +21,7 @@ def invalid(detail: str, offset: int | None = None) -> Exception:
     return error
 
 
-# ---- lengths and numbers ----------------------------------------------------------------------
+# ---- lengths and numbers ------------------------------------------------------------------------
 def encode_length(length: int) -> bytes:
     """§6.2: a length is a tagged integer, the 1-byte form up to 127; the smallest form is used."""
     for tag in INTEGER_TAGS:

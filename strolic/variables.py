@@ -42,7 +42,8 @@ class Binding:
         """ALLOC: an area of ``size`` data bytes under ``head`` (lengths set to ``size``)."""
         if head.tag in LENGTH_TAGS or head.tag == ARRAY:
             head = TagHead(head.tag, size, head.element)
-            if head.tag == ARRAY and head.element.element_size() and size % head.element.element_size():
+            element_size = head.element.element_size() if head.tag == ARRAY else 0
+            if element_size and size % element_size:
                 raise fail(K.TYPE_MISMATCH, "area size is not a multiple of the element size")
         elif size < head.element_size():
             raise fail(K.AREA_ERROR, f"{size} bytes cannot hold {type_name(head)} data")
@@ -106,7 +107,8 @@ def find_at_level(scopes: list[Scope], key: int, level: int) -> Binding:
         if scope.level == level:
             registrations = scope.table.get(key)
             if not registrations:
-                raise fail(K.UNDEFINED_DATA, f"user code %{key:04X} is not declared at level {level}")
+                raise fail(K.UNDEFINED_DATA,
+                           f"user code %{key:04X} is not declared at level {level}")
             return registrations[-1]
     raise fail(K.UNDEFINED_DATA, f"nesting level {level} is not defined")
 

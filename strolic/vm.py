@@ -229,7 +229,7 @@ class VM:
         proc.frame = self.function_frame(function, name)
 
     def end_function(self, proc: Process) -> None:
-        """END: leave the function, dropping BAL links it left; the root function ends the process."""
+        """END: leave the function, dropping its BAL links; a process's root function ends it."""
         while proc.returns:
             kind, target = proc.returns.pop()
             if kind == "call":

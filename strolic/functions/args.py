@@ -6,8 +6,9 @@ decides the result (MOD, AND, INC …) must be integers, a real there is a type 
 """
 from __future__ import annotations
 
-from ..codes import (REAL_TAGS, Num, TagHead, UserCode, round_half_away, type_name)
+from ..codes import REAL_TAGS, Num, TagHead, UserCode, round_half_away, type_name
 from ..errors import ExceptionKind as K, fail
+from ..process import Process
 
 
 def expect(value: object, cls: type | tuple, what: str) -> object:
@@ -16,16 +17,16 @@ def expect(value: object, cls: type | tuple, what: str) -> object:
     return value
 
 
-def pop_of(proc, cls: type | tuple, what: str):
+def pop_of(proc: Process, cls: type | tuple, what: str):
     return expect(proc.pop(), cls, what)
 
 
-def pop_num(proc) -> Num:
+def pop_num(proc: Process) -> Num:
     """Any of I1, I2, I4, R4, R8."""
     return pop_of(proc, Num, "a number")
 
 
-def pop_int(proc) -> Num:
+def pop_int(proc: Process) -> Num:
     """An integer operand (I1, I2, I4); reals are a type mismatch."""
     num = pop_of(proc, Num, "an integer")
     if not num.is_integer:
@@ -33,7 +34,7 @@ def pop_int(proc) -> Num:
     return num
 
 
-def pop_real(proc) -> Num:
+def pop_real(proc: Process) -> Num:
     """A real operand (R4, R8)."""
     num = pop_of(proc, Num, "a real")
     if num.tag not in REAL_TAGS:
@@ -46,20 +47,20 @@ def integer_value(num: Num) -> int:
     return num.value if num.is_integer else round_half_away(num.value)
 
 
-def pop_count(proc) -> int:
+def pop_count(proc: Process) -> int:
     """A count, position, offset or identifying number, as a Python int."""
     return integer_value(pop_num(proc))
 
 
-def pop_user(proc) -> UserCode:
+def pop_user(proc: Process) -> UserCode:
     return pop_of(proc, UserCode, "a suppressed user code (#u)")
 
 
-def pop_head(proc) -> TagHead:
+def pop_head(proc: Process) -> TagHead:
     return pop_of(proc, TagHead, "a suppressed tag (#t)")
 
 
-def pop_many(proc, count: int) -> list:
+def pop_many(proc: Process, count: int) -> list:
     """The ``count`` items under the count argument, deepest first."""
     if count < 0:
         raise fail(K.TYPE_MISMATCH, f"negative count {count}")

@@ -7,17 +7,21 @@ INC/DEC wrap, as their remarks say; NEG is two's complement, so it wraps too).
 from __future__ import annotations
 
 import math
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 from ..codes import (I2, I4, INT_RANGE, R4, R8, Num, logical, make_int, make_number, make_real,
                      smallest_int, to_float32, wrap_int)
 from ..errors import ExceptionKind as K, fail
+from ..process import Process
 from .args import pop_int, pop_num, pop_real
+
+if TYPE_CHECKING:
+    from ..vm import VM
 
 Handler = Callable[[object, object], None]
 
 
-def _pop_pair(proc, pop=pop_num) -> tuple[Num, Num]:
+def _pop_pair(proc: Process, pop=pop_num) -> tuple[Num, Num]:
     b = pop(proc)
     a = pop(proc)
     return a, b
@@ -33,7 +37,7 @@ def _checked_real(tag: int, value: float, operands: tuple[float, ...]) -> Num:
 def binary_arithmetic(int_op: Callable[[int, int], int], real_op: Callable[[float, float], float],
                       underflow_check: bool = False) -> Handler:
     """ADD, SUB, MUL: the result in the stronger type."""
-    def handler(vm, proc) -> None:
+    def handler(vm: VM, proc: Process) -> None:
         a, b = _pop_pair(proc)
         tag = max(a.tag, b.tag)
         if tag <= I4:
@@ -50,7 +54,7 @@ sub = binary_arithmetic(lambda x, y: x - y, lambda x, y: x - y)
 mul = binary_arithmetic(lambda x, y: x * y, lambda x, y: x * y, underflow_check=True)
 
 
-def div(vm, proc) -> None:
+def div(vm: VM, proc: Process) -> None:
     """DIV: real division, always R8."""
     a, b = _pop_pair(proc)
     if b.value == 0:
@@ -58,7 +62,7 @@ def div(vm, proc) -> None:
     proc.push(_checked_real(R8, a.value / b.value, (a.value, b.value)))
 
 
-def pwr(vm, proc) -> None:
+def pwr(vm: VM, proc: Process) -> None:
     """PWR: a^b in the stronger type; b < 0 is handled as division by 0."""
     a, b = _pop_pair(proc)
     if b.value < 0:
@@ -78,21 +82,21 @@ def pwr(vm, proc) -> None:
     proc.push(_checked_real(tag, value, (a.value,)))
 
 
-def _integer_division(vm, proc) -> tuple[int, Num, Num]:
+def _integer_division(vm: VM, proc: Process) -> tuple[int, Num, Num]:
     a, b = _pop_pair(proc, pop_int)
     if b.value == 0:
         raise fail(K.DIVISION_BY_ZERO, "divisor is 0")
     return max(a.tag, b.tag), a, b
 
 
-def mod(vm, proc) -> None:
+def mod(vm: VM, proc: Process) -> None:
     """MOD: c = SGN(a)·(|a| − INT(|a|/|b|)·|b|): the sign of the dividend."""
     tag, a, b = _integer_division(vm, proc)
     remainder = abs(a.value) % abs(b.value)
     proc.push(make_int(tag, remainder if a.value >= 0 else -remainder))
 
 
-def idiv(vm, proc) -> None:
+def idiv(vm: VM, proc: Process) -> None:
     """IDIV: c = SGN(a·b)·INT(|a|/|b|): truncation toward 0."""
     tag, a, b = _integer_division(vm, proc)
     quotient = abs(a.value) // abs(b.value)
@@ -101,7 +105,7 @@ def idiv(vm, proc) -> None:
 
 def step(delta: int) -> Handler:
     """INC, DEC: same type, wrapping from the positive maximum to the negative maximum."""
-    def handler(vm, proc) -> None:
+    def handler(vm: VM, proc: Process) -> None:
         a = pop_int(proc)
         proc.push(wrap_int(a.tag, a.value + delta))
     return handler
@@ -110,7 +114,7 @@ def step(delta: int) -> Handler:
 inc, dec = step(1), step(-1)
 
 
-# ---- comparison --------------------------------------------------------------------------------
+# ---- comparison ---------------------------------------------------------------------------------
 def _equal(a: Num, b: Num) -> bool:
     """EQU remarks: integers compare by value; reals only with the same type; int ≠ real."""
     if a.is_integer and b.is_integer:
@@ -119,7 +123,7 @@ def _equal(a: Num, b: Num) -> bool:
 
 
 def comparison(test: Callable[[Num, Num], bool]) -> Handler:
-    def handler(vm, proc) -> None:
+    def handler(vm: VM, proc: Process) -> None:
         a, b = _pop_pair(proc)
         proc.push(logical(test(a, b)))
     return handler
@@ -133,39 +137,39 @@ lt = comparison(lambda a, b: a.value < b.value)
 gt = comparison(lambda a, b: a.value > b.value)
 
 
-def aeq(vm, proc) -> None:
+def aeq(vm: VM, proc: Process) -> None:
     """AEQ: |a − b| < ε (ε set by SEPS)."""
     a, b = _pop_pair(proc, pop_real)
     proc.push(logical(abs(a.value - b.value) < vm.eps))
 
 
-def not_(vm, proc) -> None:
+def not_(vm: VM, proc: Process) -> None:
     proc.push(logical(pop_num(proc).value == 0))
 
 
 # ---- sign and absolute value --------------------------------------------------------------------
-def neg(vm, proc) -> None:
+def neg(vm: VM, proc: Process) -> None:
     """NEG: two's complement (the most negative value maps to itself)."""
     a = pop_int(proc)
     proc.push(wrap_int(a.tag, -a.value))
 
 
-def abs_(vm, proc) -> None:
+def abs_(vm: VM, proc: Process) -> None:
     a = pop_num(proc)
     proc.push(make_number(a.tag, abs(a.value)))
 
 
-def sgn(vm, proc) -> None:
+def sgn(vm: VM, proc: Process) -> None:
     a = pop_num(proc).value
     proc.push(Num(I2, (a > 0) - (a < 0)))
 
 
-# ---- type conversion ------------------------------------------------------------------------------
+# ---- type conversion ----------------------------------------------------------------------------
 def _floor(a: Num) -> int:
     return a.value if a.is_integer else math.floor(a.value)
 
 
-def int_(vm, proc) -> None:
+def int_(vm: VM, proc: Process) -> None:
     """INT: floor, in the smallest integer type; overflow gives ±I4 maximum."""
     low, high = INT_RANGE[I4]
     proc.push(smallest_int(min(max(_floor(pop_num(proc)), low), high)))
@@ -173,12 +177,12 @@ def int_(vm, proc) -> None:
 
 def int_of(tag: int) -> Handler:
     """INT1, INT2, INT4: floor, then the low-order bytes."""
-    def handler(vm, proc) -> None:
+    def handler(vm: VM, proc: Process) -> None:
         proc.push(wrap_int(tag, _floor(pop_num(proc))))
     return handler
 
 
-def real(vm, proc) -> None:
+def real(vm: VM, proc: Process) -> None:
     """REAL: integers become R4, reals stay as they are."""
     a = pop_num(proc)
     proc.push(Num(R4, to_float32(float(a.value))) if a.is_integer else a)
@@ -186,21 +190,21 @@ def real(vm, proc) -> None:
 
 def real_of(tag: int) -> Handler:
     """REAL4, REAL8 (R8 → R4 may overflow: numeric overflow)."""
-    def handler(vm, proc) -> None:
+    def handler(vm: VM, proc: Process) -> None:
         proc.push(make_real(tag, float(pop_num(proc).value)))
     return handler
 
 
 # ---- ε, π, angles, elementary functions ---------------------------------------------------------
-def seps(vm, proc) -> None:
+def seps(vm: VM, proc: Process) -> None:
     vm.eps = abs(float(pop_real(proc).value))
 
 
-def eps(vm, proc) -> None:
+def eps(vm: VM, proc: Process) -> None:
     proc.push(Num(R8, vm.eps))
 
 
-def pi(vm, proc) -> None:
+def pi(vm: VM, proc: Process) -> None:
     proc.push(Num(R8, math.pi))
 
 
@@ -208,7 +212,7 @@ def real_function(function: Callable[[float], float],
                   domain: Callable[[float], bool] = lambda x: True) -> Handler:
     """A real function of one R4/R8 argument; the result keeps the type. Outside ``domain``
     the standard asks for 'the same processing as division by 0'."""
-    def handler(vm, proc) -> None:
+    def handler(vm: VM, proc: Process) -> None:
         a = pop_real(proc)
         if not domain(a.value):
             raise fail(K.DIVISION_BY_ZERO, f"argument {a.value!r} outside the domain")
@@ -235,7 +239,7 @@ degrad = real_function(math.radians)
 raddeg = real_function(math.degrees)
 
 
-def atan2(vm, proc) -> None:
+def atan2(vm: VM, proc: Process) -> None:
     """ATAN2: a is y, b is x; the usual quadrant rule (atan2(0, x<0) = π)."""
     a, b = _pop_pair(proc, pop_real)
     proc.push(make_real(max(a.tag, b.tag), math.atan2(a.value, b.value)))

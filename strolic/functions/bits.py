@@ -4,20 +4,24 @@ An operand of n bits is its n-bit two's complement pattern (n = 8, 16, 32 for I1
 """
 from __future__ import annotations
 
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 from ..codes import INT_BITS, logical, wrap_int
+from ..process import Process
 from .args import pop_count, pop_int
 
+if TYPE_CHECKING:
+    from ..vm import VM
 
-def cpl(vm, proc) -> None:
+
+def cpl(vm: VM, proc: Process) -> None:
     a = pop_int(proc)
     proc.push(wrap_int(a.tag, ~a.value))
 
 
 def bitwise(op: Callable[[int, int], int]):
     """AND, OR, XOR: operands sign-extended to the stronger type (Annex 1 §5)."""
-    def handler(vm, proc) -> None:
+    def handler(vm: VM, proc: Process) -> None:
         b = pop_int(proc)
         a = pop_int(proc)
         proc.push(wrap_int(max(a.tag, b.tag), op(a.value, b.value)))
@@ -29,23 +33,23 @@ or_ = bitwise(lambda x, y: x | y)
 xor = bitwise(lambda x, y: x ^ y)
 
 
-def _bit_operands(proc):
+def _bit_operands(proc: Process):
     position = pop_count(proc)
     a = pop_int(proc)
     return a, position, 0 <= position < INT_BITS[a.tag]
 
 
-def bset(vm, proc) -> None:
+def bset(vm: VM, proc: Process) -> None:
     a, position, inside = _bit_operands(proc)
     proc.push(wrap_int(a.tag, a.value | (1 << position)) if inside else a)
 
 
-def bclr(vm, proc) -> None:
+def bclr(vm: VM, proc: Process) -> None:
     a, position, inside = _bit_operands(proc)
     proc.push(wrap_int(a.tag, a.value & ~(1 << position)) if inside else a)
 
 
-def btst(vm, proc) -> None:
+def btst(vm: VM, proc: Process) -> None:
     a, position, inside = _bit_operands(proc)
     proc.push(logical(inside and bool((a.value >> position) & 1)))
 
@@ -69,7 +73,7 @@ def _arithmetic_shift(value: int, bits: int, count: int) -> int:
 
 def shift(function: Callable[[int, int, int], int], direction: int):
     """LSH, RSH, LSHA, RSHA: a negative count shifts the other way; the type of a is kept."""
-    def handler(vm, proc) -> None:
+    def handler(vm: VM, proc: Process) -> None:
         count = pop_count(proc) * direction
         a = pop_int(proc)
         proc.push(wrap_int(a.tag, function(a.value, INT_BITS[a.tag], count)))

@@ -6,11 +6,16 @@ cannot proceed; the scheduler runs it again once something has changed.
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from ..codes import I2, Function, Num, UserCode, user_key
 from ..errors import ExceptionKind as K, fail
-from ..variables import find
 from ..process import CYCLE_WAIT, RETRY, WAIT, Process, State
+from ..variables import find
 from .args import expect, integer_value, pop_count, pop_many, pop_num, pop_user
+
+if TYPE_CHECKING:
+    from ..vm import VM
 
 
 def _state(proc: Process | None) -> Num:
@@ -21,9 +26,9 @@ def _process(vm, number: int) -> Process | None:
     return vm.processes.get(number)
 
 
-# ---- processes --------------------------------------------------------------------------------------
-def fxqt(vm, proc) -> None:
-    """FXQT #a b: 0 started, −1 a is not a function, −2 the number is not usable (≤ 0 or busy)."""
+# ---- processes ----------------------------------------------------------------------------------
+def fxqt(vm: VM, proc: Process) -> None:
+    """FXQT #a b: 0 started, −1 a is not a function, −2 number not usable (≤ 0 or busy)."""
     number = pop_count(proc)
     target = proc.pop()
     if isinstance(target, UserCode):
@@ -42,7 +47,7 @@ def fxqt(vm, proc) -> None:
     proc.push(Num(I2, 0))
 
 
-def fprecd(vm, proc) -> None:
+def fprecd(vm: VM, proc: Process) -> None:
     """FPRECD a b: priority b (smaller runs first) for process a; the result is its state."""
     priority = pop_count(proc)
     target = _process(vm, pop_count(proc))
@@ -51,7 +56,7 @@ def fprecd(vm, proc) -> None:
     proc.push(_state(target))
 
 
-def fcycle(vm, proc) -> None:
+def fcycle(vm: VM, proc: Process) -> None:
     """FCYCLE a b: process a restarts every b ms (measured from its starts; a period that
     passes while it still runs is skipped); 0 ends the cyclic start."""
     period = pop_count(proc)
@@ -62,11 +67,11 @@ def fcycle(vm, proc) -> None:
     proc.push(_state(target))
 
 
-def fdone(vm, proc) -> None:
+def fdone(vm: VM, proc: Process) -> None:
     proc.push(_state(_process(vm, pop_count(proc))))
 
 
-def fkill(vm, proc) -> None:
+def fkill(vm: VM, proc: Process) -> None:
     target = _process(vm, pop_count(proc))
     if target is None or target.state is State.DONE:
         proc.push(Num(I2, 1))
@@ -77,7 +82,7 @@ def fkill(vm, proc) -> None:
     proc.push(Num(I2, 0))
 
 
-def fsuspend(vm, proc) -> None:
+def fsuspend(vm: VM, proc: Process) -> None:
     target = _process(vm, pop_count(proc))
     if target is None or target.state in (State.DONE, State.SUSPENDED):
         proc.push(Num(I2, 1))
@@ -87,7 +92,7 @@ def fsuspend(vm, proc) -> None:
     proc.push(Num(I2, 0))
 
 
-def fresume(vm, proc) -> None:
+def fresume(vm: VM, proc: Process) -> None:
     target = _process(vm, pop_count(proc))
     if target is None or target.state is not State.SUSPENDED:
         proc.push(Num(I2, 1))
@@ -99,14 +104,14 @@ def fresume(vm, proc) -> None:
     proc.push(Num(I2, 0))
 
 
-# ---- tasks (outside the VM, through the host) ----------------------------------------------------
-def txqt(vm, proc) -> None:
+# ---- tasks (outside the VM, through the host) ---------------------------------------------------
+def txqt(vm: VM, proc: Process) -> None:
     proc.push(Num(I2, vm.host.start_task(pop_count(proc))))
 
 
 def task_setting(setter: str):
     """TPRECD (priority), TCYCLE (period in ms): a b → the state of task a."""
-    def handler(vm, proc) -> None:
+    def handler(vm: VM, proc: Process) -> None:
         value = pop_count(proc)
         number = pop_count(proc)
         getattr(vm.host, setter)(number, value)
@@ -118,13 +123,13 @@ tprecd = task_setting("set_task_priority")
 tcycle = task_setting("set_task_cycle")
 
 
-def tdone(vm, proc) -> None:
+def tdone(vm: VM, proc: Process) -> None:
     proc.push(Num(I2, vm.host.task_state(pop_count(proc))))
 
 
 def task_control(action: str):
     """TKILL, TSUSPEND, TRESUME."""
-    def handler(vm, proc) -> None:
+    def handler(vm: VM, proc: Process) -> None:
         proc.push(Num(I2, vm.host.control_task(pop_count(proc), action)))
     return handler
 
@@ -132,7 +137,7 @@ def task_control(action: str):
 tkill, tsuspend, tresume = (task_control(a) for a in ("kill", "suspend", "resume"))
 
 
-# ---- event flags -------------------------------------------------------------------------------------
+# ---- event flags --------------------------------------------------------------------------------
 def flag_number(item) -> int:
     """Event-flag and channel numbers are positive (EPOP uses 0 for 'no event')."""
     number = integer_value(expect(item, Num, "an event-flag number"))
@@ -141,7 +146,7 @@ def flag_number(item) -> int:
     return number
 
 
-def _peek_flags(proc) -> list[int]:
+def _peek_flags(proc: Process) -> list[int]:
     """The flag list a1 … an n under the count, without taking it."""
     count = integer_value(expect(proc.peek(), Num, "a count"))
     if count < 0:
@@ -149,12 +154,12 @@ def _peek_flags(proc) -> list[int]:
     return [flag_number(proc.peek(depth)) for depth in range(count, 0, -1)]
 
 
-def _take_flags(proc, count: int) -> None:
+def _take_flags(proc: Process, count: int) -> None:
     pop_num(proc)
     pop_many(proc, count)
 
 
-def lock(vm, proc):
+def lock(vm: VM, proc: Process):
     number = flag_number(proc.peek())
     if number in vm.flags:
         return WAIT
@@ -164,7 +169,7 @@ def lock(vm, proc):
     return None
 
 
-def unlock(vm, proc) -> None:
+def unlock(vm: VM, proc: Process) -> None:
     number = flag_number(proc.pop())
     if number not in vm.flags:
         proc.push(Num(I2, 1))
@@ -174,7 +179,7 @@ def unlock(vm, proc) -> None:
     proc.push(Num(I2, 0))
 
 
-def ewait(vm, proc):
+def ewait(vm: VM, proc: Process):
     number = flag_number(proc.peek())
     if number not in vm.flags:
         return WAIT
@@ -184,7 +189,7 @@ def ewait(vm, proc):
     return None
 
 
-def ewaita(vm, proc):
+def ewaita(vm: VM, proc: Process):
     """EWAITA: released when all flags are on at once; then all are turned off."""
     numbers = _peek_flags(proc)
     if not vm.flags.issuperset(numbers):
@@ -195,7 +200,7 @@ def ewaita(vm, proc):
     return None
 
 
-def ewaito(vm, proc):
+def ewaito(vm: VM, proc: Process):
     """EWAITO: released when any flag is on; the flags that are on go to the event buffer
     (in the order given) and are turned off."""
     numbers = _peek_flags(proc)
@@ -210,17 +215,17 @@ def ewaito(vm, proc):
     return None
 
 
-def epop(vm, proc) -> None:
+def epop(vm: VM, proc: Process) -> None:
     """EPOP: the first event of the buffer (first in, first out), 0 when empty."""
     proc.push(Num(I2, proc.event_buffer.pop(0) if proc.event_buffer else 0))
 
 
-def esig(vm, proc) -> None:
+def esig(vm: VM, proc: Process) -> None:
     vm.flags.add(flag_number(proc.pop()))
     vm.changed()
 
 
-def eclr(vm, proc) -> None:
+def eclr(vm: VM, proc: Process) -> None:
     """ECLR a1 … an n: those flags off; n = 0 turns every flag off."""
     count = pop_count(proc)
     numbers = [flag_number(item) for item in pop_many(proc, count)]
@@ -230,14 +235,14 @@ def eclr(vm, proc) -> None:
     vm.changed()
 
 
-# ---- channels -------------------------------------------------------------------------------------------
-def chin(vm, proc):
+# ---- channels -----------------------------------------------------------------------------------
+def chin(vm: VM, proc: Process):
     """CHIN: wait for the flag, take the datum, flag off."""
     number = flag_number(proc.peek())
     if number not in vm.flags:
         return WAIT
     if number not in vm.channels:
-        raise fail(K.UNDEFINED_DATA, f"event flag {number} is on but channel {number} holds no data")
+        raise fail(K.UNDEFINED_DATA, f"flag {number} is on but channel {number} holds no data")
     proc.pop()
     vm.flags.discard(number)
     vm.changed()
@@ -245,7 +250,7 @@ def chin(vm, proc):
     return None
 
 
-def chout(vm, proc):
+def chout(vm: VM, proc: Process):
     """CHOUT a b: wait for the flag to be off, leave the datum, flag on."""
     number = flag_number(proc.peek(1))
     if number in vm.flags:
@@ -258,7 +263,7 @@ def chout(vm, proc):
     return None
 
 
-def share(vm, proc) -> None:
+def share(vm: VM, proc: Process) -> None:
     """SHARE #a b: user code a (declared) is reachable by other tasks as shared variable b."""
     number = pop_count(proc)
     key = user_key(pop_user(proc).code)

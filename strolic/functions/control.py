@@ -5,36 +5,41 @@ negative. Outside a function the branch codes pop their operands and do nothing 
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from ..codes import VAR_CODE, Function, FunctionCode, UserCode, user_key
 from ..errors import ExceptionKind as K, fail
-from ..process import PUSH
+from ..process import PUSH, Process
 from ..variables import Scope, declare, find, find_at_level, free as free_binding
 from .args import expect, pop_count, pop_num, pop_user
 
+if TYPE_CHECKING:
+    from ..vm import VM
 
-def _branch_if(proc, taken: bool, offset: int) -> None:
+
+def _branch_if(proc: Process, taken: bool, offset: int) -> None:
     frame = proc.frame
     if taken and frame.function is not None:
         frame.jump(offset, frame.pc - 1)
 
 
-def bra(vm, proc) -> None:
+def bra(vm: VM, proc: Process) -> None:
     _branch_if(proc, True, pop_count(proc))
 
 
-def brf(vm, proc) -> None:
+def brf(vm: VM, proc: Process) -> None:
     """BRF: branch when the condition is 0 (a logical test: any type, 0 is false)."""
     offset = pop_count(proc)
     _branch_if(proc, pop_num(proc).value == 0, offset)
 
 
-def brt(vm, proc) -> None:
+def brt(vm: VM, proc: Process) -> None:
     """BRT: branch when the condition is true, i.e. not 0 (Annex 1 §7)."""
     offset = pop_count(proc)
     _branch_if(proc, pop_num(proc).value != 0, offset)
 
 
-def bal(vm, proc) -> None:
+def bal(vm: VM, proc: Process) -> None:
     """BAL: push the position after BAL on the return stack and branch."""
     offset = pop_count(proc)
     frame = proc.frame
@@ -46,7 +51,7 @@ def bal(vm, proc) -> None:
     frame.jump(offset, frame.pc - 1)
 
 
-def ret(vm, proc) -> None:
+def ret(vm: VM, proc: Process) -> None:
     """RET: back to the last BAL or to the caller; the root function of a process ends it."""
     if proc.returns:
         kind, target = proc.returns.pop()
@@ -60,12 +65,12 @@ def ret(vm, proc) -> None:
         raise fail(K.NO_RETURN_DESTINATION, "RET with nothing to return to")
 
 
-def end(vm, proc) -> None:
+def end(vm: VM, proc: Process) -> None:
     """END: end of the function body, a return; outside a function it does nothing."""
     vm.end_function(proc)
 
 
-def gret(vm, proc) -> None:
+def gret(vm: VM, proc: Process) -> None:
     """GRET: clear the return stack and go back to the input stream (a process ends)."""
     if proc.frame.function is None:
         return
@@ -76,7 +81,7 @@ def gret(vm, proc) -> None:
         vm.finish(proc)
 
 
-def fdef(vm, proc) -> None:
+def fdef(vm: VM, proc: Process) -> None:
     """FDEF: the function data after FDEF goes into the user code without the stack."""
     target = pop_user(proc)
     frame = proc.frame
@@ -88,8 +93,8 @@ def fdef(vm, proc) -> None:
     find(proc.scopes, user_key(target.code)).assign(following)
 
 
-# ---- nesting (Reference 1 §8) ----------------------------------------------------------------------
-def nestin(vm, proc) -> None:
+# ---- nesting (Reference 1 §8) -------------------------------------------------------------------
+def nestin(vm: VM, proc: Process) -> None:
     level = pop_count(proc)
     if level < 0:
         raise fail(K.UNDEFINED_DATA, f"negative nesting level {level}")
@@ -98,30 +103,30 @@ def nestin(vm, proc) -> None:
     proc.scopes.append(Scope(level))
 
 
-def nestout(vm, proc) -> None:
+def nestout(vm: VM, proc: Process) -> None:
     """NESTOUT: drop the innermost local space; at the outermost level it does nothing."""
     if len(proc.scopes) > 1:
         proc.scopes.pop()
 
 
-def npush(vm, proc) -> None:
+def npush(vm: VM, proc: Process) -> None:
     level = pop_count(proc)
     target = pop_user(proc)
     proc.push(find_at_level(proc.scopes, user_key(target.code), level).value())
 
 
-def npop(vm, proc) -> None:
+def npop(vm: VM, proc: Process) -> None:
     level = pop_count(proc)
     target = pop_user(proc)
     find_at_level(proc.scopes, user_key(target.code), level).assign(proc.pop())
 
 
-# ---- declaration (Reference 1 §5) ----------------------------------------------------------------
-def var(vm, proc) -> None:
+# ---- declaration (Reference 1 §5) ---------------------------------------------------------------
+def var(vm: VM, proc: Process) -> None:
     proc.push(FunctionCode(VAR_CODE))
 
 
-def _declared_codes(proc) -> list[int]:
+def _declared_codes(proc: Process) -> list[int]:
     """The user codes down to the VAR marker, which is removed too."""
     keys = []
     while True:
@@ -131,7 +136,7 @@ def _declared_codes(proc) -> list[int]:
         keys.append(user_key(expect(item, UserCode, "a suppressed user code (#u) or VAR").code))
 
 
-def dcl(vm, proc) -> None:
+def dcl(vm: VM, proc: Process) -> None:
     keys = _declared_codes(proc)
     if len(set(keys)) != len(keys):
         raise fail(K.TYPE_MISMATCH, "a user code appears twice in one declaration")
@@ -139,6 +144,6 @@ def dcl(vm, proc) -> None:
         declare(proc.scopes[-1], key)
 
 
-def free(vm, proc) -> None:
+def free(vm: VM, proc: Process) -> None:
     for key in _declared_codes(proc):
         free_binding(proc.scopes, key)

@@ -6,55 +6,61 @@ stay inside the area of the user code (which ALLOC may make larger than the valu
 """
 from __future__ import annotations
 
-from ..codes import (ARRAY, DATA_TYPES, I1, I2, I4, INDIRECT, INT_RANGE, NUMERIC_TAGS, R4, STRING, SUPPRESS,
-                     TRANSFORM, VECTOR, Array, Num, TagHead, UserCode, make_number,
-                     round_half_away, smallest_int, type_name, user_code_of, user_key,
-                     wrap_int)
+from typing import TYPE_CHECKING
+
+from ..codes import (ARRAY, DATA_TYPES, I1, I2, I4, INDIRECT, INT_RANGE, NUMERIC_TAGS, R4,
+                     STRING, SUPPRESS, TRANSFORM, VECTOR, Array, Num, TagHead, UserCode,
+                     make_number, round_half_away, smallest_int, type_name, user_code_of,
+                     user_key, wrap_int)
 from ..errors import ExceptionKind as K, fail
+from ..process import Process
 from ..values import array_elements, data_of, head_of, value_from_data
 from ..variables import find
 from .args import (expect, integer_value, pop_count, pop_head, pop_many, pop_num, pop_of,
                    pop_user)
 
+if TYPE_CHECKING:
+    from ..vm import VM
 
-# ---- stack operations -------------------------------------------------------------------------
-def dup(vm, proc) -> None:
+
+# ---- stack operations ---------------------------------------------------------------------------
+def dup(vm: VM, proc: Process) -> None:
     proc.push(proc.peek())
 
 
-def drop(vm, proc) -> None:
+def drop(vm: VM, proc: Process) -> None:
     """DROP: an empty stack is not an error."""
     if proc.stack:
         proc.stack.pop()
 
 
-def exch(vm, proc) -> None:
+def exch(vm: VM, proc: Process) -> None:
     """EXCH: fewer than two items is a no-op."""
     stack = proc.stack
     if len(stack) >= 2:
         stack[-1], stack[-2] = stack[-2], stack[-1]
 
 
-def binding_of(proc, target: UserCode):
+def binding_of(proc: Process, target: UserCode):
     return find(proc.scopes, user_key(target.code))
 
 
-def push(vm, proc) -> None:
+def push(vm: VM, proc: Process) -> None:
     """PUSH: the value of the user code, a function as data (not executed)."""
     proc.push(binding_of(proc, pop_user(proc)).value())
 
 
-def pop(vm, proc) -> None:
+def pop(vm: VM, proc: Process) -> None:
     target = pop_user(proc)
     binding_of(proc, target).assign(proc.pop())
 
 
-def store(vm, proc) -> None:
+def store(vm: VM, proc: Process) -> None:
     value = proc.pop()
     binding_of(proc, pop_user(proc)).assign(value)
 
 
-# ---- bytes of structured data ------------------------------------------------------------------
+# ---- bytes of structured data -------------------------------------------------------------------
 def _area_slice(binding, start: int, size: int) -> bytearray:
     area = binding.bytes_area()
     if start < 0:
@@ -64,7 +70,7 @@ def _area_slice(binding, start: int, size: int) -> bytearray:
     return area
 
 
-def extb(vm, proc) -> None:
+def extb(vm: VM, proc: Process) -> None:
     """EXTB #a b #c: the bytes for type c at offset b, tagged c."""
     head = pop_head(proc)
     start = pop_count(proc)
@@ -74,7 +80,7 @@ def extb(vm, proc) -> None:
     proc.push(value_from_data(head, bytes(area[start:start + size])))
 
 
-def embb(vm, proc) -> None:
+def embb(vm: VM, proc: Process) -> None:
     """EMBB #a b c: the data part of c (no tag, no length) written at offset b."""
     data = data_of(proc.pop())
     start = pop_count(proc)
@@ -98,7 +104,7 @@ def _element_layout(binding) -> tuple[TagHead, int, bool]:
                f"EXTE/EMBE need Ar, St, Vec or Trn, not {type_name(binding.value())}")
 
 
-def exte(vm, proc) -> None:
+def exte(vm: VM, proc: Process) -> None:
     index = pop_count(proc)
     binding = binding_of(proc, pop_user(proc))
     element, size, _ = _element_layout(binding)
@@ -106,7 +112,7 @@ def exte(vm, proc) -> None:
     proc.push(value_from_data(element, bytes(area[index * size:index * size + size])))
 
 
-def embe(vm, proc) -> None:
+def embe(vm: VM, proc: Process) -> None:
     """EMBE: arrays take the same type only; strings a number rounded to a byte; Vec/Trn → R4."""
     value = proc.pop()
     index = pop_count(proc)
@@ -129,7 +135,7 @@ def numeric(value) -> Num:
     return expect(value, Num, "a number")
 
 
-# ---- arrays ----------------------------------------------------------------------------------------
+# ---- arrays -------------------------------------------------------------------------------------
 def convert_element(value, head: TagHead):
     """CONSA's conversion of an element to the element type, or the §9 type mismatch."""
     if head.tag in NUMERIC_TAGS and isinstance(value, Num):
@@ -145,7 +151,7 @@ def convert_element(value, head: TagHead):
     raise fail(K.TYPE_MISMATCH, f"{type_name(value)} cannot become the element type")
 
 
-def consa(vm, proc) -> None:
+def consa(vm: VM, proc: Process) -> None:
     head = pop_head(proc)
     count = pop_count(proc)
     if head.tag in (SUPPRESS, INDIRECT):
@@ -154,31 +160,31 @@ def consa(vm, proc) -> None:
     proc.push(Array(head, b"".join(data_of(convert_element(e, head)) for e in elements)))
 
 
-def desta(vm, proc) -> None:
+def desta(vm: VM, proc: Process) -> None:
     """DESTA: the elements from the smallest subscript, then their count (smallest integer type)."""
     elements = array_elements(pop_of(proc, Array, "an array"))
     proc.stack.extend(elements)
     proc.push(smallest_int(len(elements)))
 
 
-# ---- user codes ----------------------------------------------------------------------------------
-def consu(vm, proc) -> None:
+# ---- user codes ---------------------------------------------------------------------------------
+def consu(vm: VM, proc: Process) -> None:
     proc.push(UserCode(user_code_of(pop_num(proc))))
 
 
-def destu(vm, proc) -> None:
+def destu(vm: VM, proc: Process) -> None:
     """DESTU: the code as I2 bit pattern (2-byte codes) or I4 bit pattern (extended codes)."""
     code = pop_user(proc).code
     proc.push(wrap_int(I2, code) if code <= 0xFFFF else wrap_int(I4, code))
 
 
-# ---- heap areas ------------------------------------------------------------------------------------
+# ---- heap areas ---------------------------------------------------------------------------------
 def _heap_in_use(vm) -> int:
     scopes = [vm.globals] + [s for p in vm.processes.values() for s in p.scopes[1:]]
     return sum(b.size() or 0 for s in scopes for stack in s.table.values() for b in stack)
 
 
-def alloc(vm, proc) -> None:
+def alloc(vm: VM, proc: Process) -> None:
     """ALLOC and ALLOCZ a #b #c: a data bytes under tag b for c; 0 asks the free size; a
     shortfall is returned negative. Every area starts zeroed (the Null code is 0x00), so the
     two functions are one."""
@@ -198,7 +204,7 @@ def alloc(vm, proc) -> None:
         proc.push(smallest_int(size))
 
 
-def aclr(vm, proc) -> None:
+def aclr(vm: VM, proc: Process) -> None:
     binding = binding_of(proc, pop_user(proc))
     if binding.defined:
         area = binding.bytes_area()
@@ -206,11 +212,11 @@ def aclr(vm, proc) -> None:
         binding.written()
 
 
-def arels(vm, proc) -> None:
+def arels(vm: VM, proc: Process) -> None:
     binding_of(proc, pop_user(proc)).release()
 
 
-def asize(vm, proc) -> None:
+def asize(vm: VM, proc: Process) -> None:
     """ASIZE: data bytes of the area (I2, or I4 when larger), −1 when there is none."""
     size = binding_of(proc, pop_user(proc)).size()
     proc.push(Num(I2, -1) if size is None else make_number(I2 if size <= 0x7FFF else I4, size))

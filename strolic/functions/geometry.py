@@ -6,14 +6,19 @@ result rounded to R4. Pose data (§15, implementation-defined) is documented in 
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..codes import I2, R4, R8, Num, Pose, Trn, Vec, make_int, make_real, to_float32
 from ..errors import ExceptionKind as K, fail
+from ..process import Process
 from .args import expect, pop_count, pop_many, pop_num, pop_of
 
-# ---- conversions -------------------------------------------------------------------------------
+if TYPE_CHECKING:
+    from ..vm import VM
+
+# ---- conversions --------------------------------------------------------------------------------
 def vec_of(values) -> Vec:
     return Vec(tuple(to_float32(float(v)) for v in values))
 
@@ -38,21 +43,21 @@ def trn_of(matrix: np.ndarray) -> Trn:
     return Trn(tuple(to_float32(v) for v in storage_order(matrix)))
 
 
-def pop_vec(proc) -> Vec:
+def pop_vec(proc: Process) -> Vec:
     return pop_of(proc, Vec, "a vector")
 
 
-def pop_trn(proc) -> Trn:
+def pop_trn(proc: Process) -> Trn:
     return pop_of(proc, Trn, "a homogeneous transform")
 
 
-# ---- vectors -------------------------------------------------------------------------------------
-def vlen(vm, proc) -> None:
+# ---- vectors ------------------------------------------------------------------------------------
+def vlen(vm: VM, proc: Process) -> None:
     proc.push(make_real(R4, math.hypot(*pop_vec(proc).xyz)))
 
 
 def vector_binary(op):
-    def handler(vm, proc) -> None:
+    def handler(vm: VM, proc: Process) -> None:
         b = np.array(pop_vec(proc).xyz)
         a = np.array(pop_vec(proc).xyz)
         proc.push(vec_of(op(a, b)))
@@ -64,30 +69,30 @@ vsub = vector_binary(np.subtract)
 vprodo = vector_binary(np.cross)
 
 
-def vtimes(vm, proc) -> None:
+def vtimes(vm: VM, proc: Process) -> None:
     """VTIMES: a b → b·a (vector first, scalar on top)."""
     scale = float(pop_num(proc).value)
     proc.push(vec_of(np.array(pop_vec(proc).xyz) * scale))
 
 
-def vprodi(vm, proc) -> None:
+def vprodi(vm: VM, proc: Process) -> None:
     b = np.array(pop_vec(proc).xyz)
     a = np.array(pop_vec(proc).xyz)
     proc.push(make_real(R4, float(np.dot(a, b))))
 
 
-def consv(vm, proc) -> None:
+def consv(vm: VM, proc: Process) -> None:
     z, y, x = pop_num(proc), pop_num(proc), pop_num(proc)
     proc.push(vec_of((x.value, y.value, z.value)))
 
 
-def destv(vm, proc) -> None:
+def destv(vm: VM, proc: Process) -> None:
     for component in pop_vec(proc).xyz:
         proc.push(Num(R4, component))
 
 
-# ---- transforms ----------------------------------------------------------------------------------
-def tprod(vm, proc) -> None:
+# ---- transforms ---------------------------------------------------------------------------------
+def tprod(vm: VM, proc: Process) -> None:
     """TPROD: C = A·B (A pushed first)."""
     b = matrix_of(pop_trn(proc))
     a = matrix_of(pop_trn(proc))
@@ -105,18 +110,18 @@ def invert(matrix: np.ndarray) -> np.ndarray:
     return inverse
 
 
-def tinv(vm, proc) -> None:
+def tinv(vm: VM, proc: Process) -> None:
     proc.push(trn_of(invert(matrix_of(pop_trn(proc)))))
 
 
-def tprodv(vm, proc) -> None:
+def tprodv(vm: VM, proc: Process) -> None:
     """TPRODV: the vector is a point, c = R·b + p."""
     b = np.array(pop_vec(proc).xyz)
     a = matrix_of(pop_trn(proc))
     proc.push(vec_of(a[:3, :3] @ b + a[:3, 3]))
 
 
-# ---- poses ------------------------------------------------------------------------------------------
+# ---- poses --------------------------------------------------------------------------------------
 POSE_ELEMENTS = 14   # 12 × R8 transform (storage order), I2 configuration, R8 elbow angle (degree)
 
 
@@ -136,29 +141,29 @@ def pose_parts(pose: Pose) -> tuple[np.ndarray, int, float]:
     return matrix, elements[12].value, float(elements[13].value)
 
 
-def pop_pose(proc) -> tuple[np.ndarray, int, float]:
+def pop_pose(proc: Process) -> tuple[np.ndarray, int, float]:
     return pose_parts(pop_of(proc, Pose, "a pose"))
 
 
-def trn(vm, proc) -> None:
+def trn(vm: VM, proc: Process) -> None:
     matrix, _, _ = pop_pose(proc)
     proc.push(trn_of(matrix))
 
 
-def pnt(vm, proc) -> None:
+def pnt(vm: VM, proc: Process) -> None:
     """PNT: the configuration and elbow angle come from the VM's current configuration."""
     matrix = matrix_of(pop_trn(proc))
     proc.push(pose_of(matrix, vm.configuration, vm.elbow))
 
 
-def loc(vm, proc) -> None:
+def loc(vm: VM, proc: Process) -> None:
     matrix, _, _ = pop_pose(proc)
     proc.push(vec_of(matrix[:3, 3]))
 
 
 def deviation(in_tool_frame: bool):
     """DEV: p' = p + b (robot frame); DEVH: p' = p + R·b (tool frame)."""
-    def handler(vm, proc) -> None:
+    def handler(vm: VM, proc: Process) -> None:
         shift = np.array(pop_vec(proc).xyz)
         matrix, configuration, elbow = pop_pose(proc)
         matrix = matrix.copy()
@@ -171,7 +176,7 @@ dev = deviation(False)
 devh = deviation(True)
 
 
-def padd(vm, proc) -> None:
+def padd(vm: VM, proc: Process) -> None:
     """PADD a b: the pose reached by the relative move a from b (DESIGN.md: p' = p + Δp,
     R' = ΔR·R in the robot frame); configuration from a, elbow angles add."""
     base, _, base_elbow = pop_pose(proc)
@@ -182,7 +187,7 @@ def padd(vm, proc) -> None:
     proc.push(pose_of(result, configuration, elbow + base_elbow))
 
 
-def psub(vm, proc) -> None:
+def psub(vm: VM, proc: Process) -> None:
     """PSUB a b: the relative pose d with d b PADD = a (Δp = p_a − p_b, ΔR = R_a·R_bᵀ)."""
     base, _, base_elbow = pop_pose(proc)
     target, configuration, elbow = pop_pose(proc)
@@ -192,7 +197,7 @@ def psub(vm, proc) -> None:
     proc.push(pose_of(result, configuration, elbow - base_elbow))
 
 
-def consp(vm, proc) -> None:
+def consp(vm: VM, proc: Process) -> None:
     """CONSP a1 … a14 14: numbers in the pose layout (see POSE_ELEMENTS)."""
     count = pop_count(proc)
     if count != POSE_ELEMENTS:
@@ -202,7 +207,7 @@ def consp(vm, proc) -> None:
     proc.push(pose_of(matrix, configuration, elbow))
 
 
-def destp(vm, proc) -> None:
+def destp(vm: VM, proc: Process) -> None:
     pose = pop_of(proc, Pose, "a pose")
     pose_parts(pose)
     proc.stack.extend(pose.elements)

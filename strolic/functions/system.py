@@ -1,25 +1,30 @@
 """EF6C–EF75: identification, INIT, trace, and the exchange with the programming device."""
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+from .. import literals
 from ..codes import ACK_CODE, DATA_TYPES, Str
 from ..errors import ExceptionKind as K, fail
-from ..process import State
-from .. import literals
+from ..process import Process, State
 from ..values import encode_value
+
+if TYPE_CHECKING:
+    from ..vm import VM
 
 VERSION_ID = b"STROLIC JIS B 8440-1994"      # the prefix EF6C requires, as printed
 SYSTEM_ID = b"acti_ros2 strolic 0.1 (Python STROLIC virtual machine, acti_ros2 project)"
 
 
-def verid(vm, proc) -> None:
+def verid(vm: VM, proc: Process) -> None:
     proc.push(Str(VERSION_ID))
 
 
-def sysid(vm, proc) -> None:
+def sysid(vm: VM, proc: Process) -> None:
     proc.push(Str(SYSTEM_ID))
 
 
-def init(vm, proc) -> None:
+def init(vm: VM, proc: Process) -> None:
     """INIT: stacks, variables, heap, nesting, ε, trace, configuration, flags, channels and all
     processes are reset; the program continues with the next code of the input stream."""
     main = vm.main
@@ -37,31 +42,31 @@ def init(vm, proc) -> None:
         proc.state = State.DONE
 
 
-def tron(vm, proc) -> None:
+def tron(vm: VM, proc: Process) -> None:
     vm.trace = True
 
 
-def troff(vm, proc) -> None:
+def troff(vm: VM, proc: Process) -> None:
     vm.trace = False
 
 
-def trace(vm, proc) -> None:
+def trace(vm: VM, proc: Process) -> None:
     """TRACE: the item goes to the console in the text form when the trace flag is on."""
     item = proc.pop()
     if vm.trace:
         vm.host.console(f"TRACE {literals.format_value(item)}")
 
 
-def sync(vm, proc) -> None:
+def sync(vm: VM, proc: Process) -> None:
     """SYNC: this VM is always in a normal state, so the answer is ACK."""
     vm.host.send(ACK_CODE.to_bytes(2, "big"))
 
 
-def reply_code(vm, proc) -> None:
+def reply_code(vm: VM, proc: Process) -> None:
     """ACK, NAK: replies to the host, never executed; received in a program they are ignored."""
 
 
-def result(vm, proc) -> None:
+def result(vm: VM, proc: Process) -> None:
     """RESULT: the value, as a tagged data code, on the output stream."""
     value = proc.pop()
     if not isinstance(value, DATA_TYPES):
