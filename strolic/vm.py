@@ -35,7 +35,7 @@ class VM:
         self.executed = 0                  # instructions of the current run (budget)
         self.reset()
 
-    # ---- state ----------------------------------------------------------------------
+    # ---- state ----------------------------------------------------------------------------------
     def reset(self) -> None:
         """Everything INIT initialises (EF6E)."""
         self.globals = Scope(0)
@@ -53,7 +53,7 @@ class VM:
     def scopes_for_new_process(self) -> list[Scope]:
         return [self.globals]
 
-    # ---- compiling codes into instructions ----------------------------------------------------------------------
+    # ---- compiling codes into instructions ------------------------------------------------------
     def compile(self, codes: list, origin: int = 0) -> list:
         """Instructions (op, argument, offset in the body, size) from decoded codes."""
         instructions = []
@@ -79,7 +79,7 @@ class VM:
                                                                  function.origin or 0)
         return Frame(codes, function.origin or 0, function, name)
 
-    # ---- running ----------------------------------------------------------------------
+    # ---- running --------------------------------------------------------------------------------
     def run(self, program: bytes | list, budget: int | None = None) -> Process:
         """Run a program (bytes or decoded codes) to its end; returns the main process.
 
@@ -213,7 +213,7 @@ class VM:
             name += f" (process {proc.number})"
         return error.located(name, frame.origin + offset)
 
-    # ---- frames and calls ----------------------------------------------------------------------
+    # ---- frames and calls -----------------------------------------------------------------------
     def fall_off(self, proc: Process) -> None:
         """Past the last code: the program ends, or a function body returns like END."""
         if proc.frame is proc.root and proc.frame.function is None:
