@@ -27,9 +27,9 @@ def _pop_pair(proc: Process, pop=pop_num) -> tuple[Num, Num]:
     return a, b
 
 
-def _checked_real(tag: int, value: float, operands: tuple[float, ...]) -> Num:
-    """A real result; 0 from non-zero operands of ×, ÷, ^ is underflow (§9)."""
-    if value == 0.0 and all(operands):
+def _checked_real(tag: int, value: float, *operands: float) -> Num:
+    """A real result; 0 computed from non-zero ``operands`` (of ×, ÷, ^) is underflow (§9)."""
+    if value == 0.0 and operands and all(operands):
         raise fail(K.NUMERIC_UNDERFLOW, "real result underflows to 0")
     return make_real(tag, value)
 
@@ -44,8 +44,8 @@ def binary_arithmetic(int_op: Callable[[int, int], int], real_op: Callable[[floa
             proc.push(make_int(tag, int_op(a.value, b.value)))
         else:
             value = real_op(float(a.value), float(b.value))
-            operands = (a.value, b.value) if underflow_check else (0,)
-            proc.push(_checked_real(tag, value, operands))
+            operands = (a.value, b.value) if underflow_check else ()
+            proc.push(_checked_real(tag, value, *operands))
     return handler
 
 
@@ -59,7 +59,7 @@ def div(vm: VM, proc: Process) -> None:
     a, b = _pop_pair(proc)
     if b.value == 0:
         raise fail(K.DIVISION_BY_ZERO, "DIV by 0")
-    proc.push(_checked_real(R8, a.value / b.value, (a.value, b.value)))
+    proc.push(_checked_real(R8, a.value / b.value, a.value, b.value))
 
 
 def pwr(vm: VM, proc: Process) -> None:
@@ -79,7 +79,7 @@ def pwr(vm: VM, proc: Process) -> None:
         value = math.pow(a.value, b.value)
     except OverflowError:
         raise fail(K.NUMERIC_OVERFLOW, "PWR result too large") from None
-    proc.push(_checked_real(tag, value, (a.value,)))
+    proc.push(_checked_real(tag, value, a.value))
 
 
 def _integer_division(vm: VM, proc: Process) -> tuple[int, Num, Num]:
