@@ -35,7 +35,7 @@ REAL_FORMAT = {R4: ">f", R8: ">d"}
 # ---- code areas (§16, §17, Annex 1 §2) ----------------------------------------------------------
 END_CODE = 0xEF5C
 VAR_CODE = 0xEF63
-ACK_CODE, NAK_CODE = 0xEF73, 0xEF74
+ACK_CODE = 0xEF73
 USER_MIN, USER_MAX = 0x1000, 0xEAFF
 EXT_USER_MIN, EXT_USER_MAX = 0xEB00_0000, 0xEBFF_FFFF
 EXT_ALIAS_MIN, EXT_ALIAS_MAX = 0xEB00_1000, 0xEB00_EAFF
@@ -51,7 +51,7 @@ def user_code_of(num: Num) -> int:
     if num.is_integer:
         value = num.value & (0xFFFF if num.tag <= I2 else 0xFFFF_FFFF)
     else:
-        value = round_half_away(num.value) if math.isfinite(num.value) else -1
+        value = round_half_away(num.value)
     if not is_user_code(value):
         raise fail(K.TYPE_MISMATCH, f"{value:#x} is not a user code number")
     return value
