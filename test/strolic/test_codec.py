@@ -139,6 +139,11 @@ def data_values(codes):
         st.lists(numbers(), max_size=4).map(lambda e: Pose(tuple(e))),
         st.lists(st.integers(-2**15, 2**15 - 1), max_size=5).map(
             lambda v: Array(TagHead(I2), struct.pack(f">{len(v)}h", *v))),
+        st.lists(f32, max_size=4).map(lambda v: Array(TagHead(R4), struct.pack(f">{len(v)}f", *v))),
+        st.integers(0, 3).flatmap(lambda k: st.lists(st.binary(min_size=k, max_size=k), max_size=3)
+                                  .map(lambda v: Array(TagHead(0xFA, k), b"".join(v)))),
+        st.lists(st.tuples(f32, f32, f32), max_size=2).map(
+            lambda v: Array(TagHead(0xFF01), b"".join(struct.pack(">3f", *x) for x in v))),
         codes.map(lambda body: Function(encode(body + [Code(CodeKind.CALL, 0xEF5C, 0, 0)]))))
 
 
