@@ -49,7 +49,7 @@ def asm(args: argparse.Namespace) -> int:
 
 def dis(args: argparse.Namespace) -> int:
     try:
-        sys.stdout.write(disassemble(Path(args.input).read_bytes()))
+        sys.stdout.write(disassemble(Path(args.input).read_bytes(), offsets=args.offsets))
     except StrolicError as error:
         print(error.report(), file=sys.stderr)
         return 1
@@ -71,6 +71,8 @@ def main(argv: list[str] | None = None) -> int:
     asm_parser.set_defaults(action=asm)
     dis_parser = commands.add_parser("dis", help="raw code → text form")
     dis_parser.add_argument("input")
+    dis_parser.add_argument("--offsets", action="store_true",
+                            help="end each line with a comment giving the code's byte offset")
     dis_parser.set_defaults(action=dis)
     args = parser.parse_args(argv)
     return args.action(args)

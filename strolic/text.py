@@ -8,7 +8,7 @@ from __future__ import annotations
 import re
 
 from . import opcodes
-from .codec import Code, CodeKind, decode, encode, encode_code
+from .codec import Code, CodeKind, decode, decode_function, encode, encode_code
 from .codes import (ARRAY, I2, INDIRECT, LENGTH_TAGS, NUMERIC_TAGS, R8, REAL_TAGS, SUPPRESS,
                     TAGS_BY_NAME, Array, Function, FunctionCode, Num, Pose, Record, Str, TagHead,
                     Trn, UserCode, Vec, is_user_code, make_number, smallest_int, to_float32)
@@ -306,20 +306,21 @@ def format_code(code: Code) -> str:
     return format_value(code.value)
 
 
-def disassemble_codes(codes: list[Code], indent: int = 0) -> list[str]:
+def disassemble_codes(codes: list[Code], indent: int = 0, offsets: bool = False) -> list[str]:
+    """Lines of text; with ``offsets`` each ends in a comment giving the code's byte offset."""
     lines = []
     pad = "  " * indent
     for code in codes:
+        note = f"  ; @{code.offset}" if offsets else ""
         if code.kind is CodeKind.DATA and isinstance(code.value, Function):
-            lines.append(pad + "Fn{")
-            lines.extend(disassemble_codes(decode(code.value.body, code.offset), indent + 1))
+            lines.append(pad + "Fn{" + note)
+            lines.extend(disassemble_codes(decode_function(code.value), indent + 1, offsets))
             lines.append(pad + "}")
         else:
-            lines.append(pad + format_code(code))
+            lines.append(pad + format_code(code) + note)
     return lines
 
 
-def disassemble(program: bytes) -> str:
+def disassemble(program: bytes, offsets: bool = False) -> str:
     """Program bytes → text form, one code per line, function bodies indented."""
-    return "\n".join(disassemble_codes(decode(program))) + "\n"
-
+    return "\n".join(disassemble_codes(decode(program), offsets=offsets)) + "\n"

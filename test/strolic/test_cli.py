@@ -66,6 +66,18 @@ def test_budget_and_output_stream(tmp_path: Path) -> None:
     assert "output: 7" in result.stderr
 
 
+def test_dis_offsets_match_exception_reports(tmp_path: Path) -> None:
+    (tmp_path / "p.sasm").write_text(".name f %1000 VAR #f DCL #f FDEF Fn{ 1 0 IDIV END } f\n")
+    strolic("asm", str(tmp_path / "p.sasm"), str(tmp_path / "p.stl"))
+    report = strolic("run", str(tmp_path / "p.stl")).stderr
+    listing = strolic("dis", str(tmp_path / "p.stl"), "--offsets").stdout
+    offset = report.split("at byte ")[1].split()[0]
+    assert f"IDIV  ; @{offset}" in listing
+    (tmp_path / "again.sasm").write_text(listing)
+    strolic("asm", str(tmp_path / "again.sasm"), str(tmp_path / "again.stl"))
+    assert (tmp_path / "again.stl").read_bytes() == (tmp_path / "p.stl").read_bytes()
+
+
 def test_asm_and_dis_report_bad_input(tmp_path: Path) -> None:
     (tmp_path / "bad.sasm").write_text("1 NOSUCH\n")
     assert strolic("asm", str(tmp_path / "bad.sasm"), str(tmp_path / "x.stl")).returncode != 0
