@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import pytest
 
-from cases import CASES
+from strolic_cases import CASES
 from conftest import error_of, stack_of
 from strolic.errors import ExceptionKind
 

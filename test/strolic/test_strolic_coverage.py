@@ -1,7 +1,7 @@
 """The coverage table: no function of the opcode table in EF00–EF8E may be silently missing."""
 from __future__ import annotations
 
-from cases import CASES, LISTED_EXCEPTIONS
+from strolic_cases import CASES, LISTED_EXCEPTIONS
 from strolic import opcodes
 from strolic.errors import ExceptionKind
 

@@ -1,6 +1,6 @@
 """Table of cases for every built-in function EF00–EF8E: normal cases, type promotion, and the
 exceptions the standard lists. Keys are mnemonics; this table is also the coverage table
-(``test_coverage.py`` checks that no function of the opcode table is missing).
+(``test_strolic_coverage.py`` checks that no function of the opcode table is missing).
 
 A case is ``(program, expected)``: the expected final stack in the text form (bottom first), or
 the ExceptionKind that must stop the program. Programs run after ``conftest.PRELUDE``, which

@@ -11,7 +11,7 @@ from strolic.codes import Num, I2
 from strolic.errors import ExceptionKind as K, StrolicError
 from strolic.text import assemble
 from strolic.vm import VM
-from test_codec import program_codes
+from test_strolic_codec import program_codes
 
 
 def test_exception_report_names_function_offset_and_kind() -> None:
