@@ -175,19 +175,81 @@ VM_FUNCTIONS = [
     op(0xEF8E, "SHARE", "#u number --", cc.share),
 ]
 
-# System (EE) and robot-control (ED) functions: named for the assembler and disassembler; their
-# handlers come with the robot binding (through Host.call until then).
-SYSTEM_AND_ROBOT_NAMES = {
-    0xEE00: "TIME DATE CLOCK STIME SDATE CLRCLK PACKTM UNPKTM PACKDT UNPKDT CNFG DOUT DIN IOWAIT "
-            "ACT ACTRS REACT ACTCODE ACTION TIMER RTIMER TACTION FSTAT OUTPUT INPUT LOUTPUT LINPUT "
-            "FOPEN FCLOSE PUTC GETC DECODE1 ENCODE1 DECODE2 ENCODE2",
-    0xED00: "JSPEED SPEED ACCEL1 ACCEL2 DECEL1 DECEL2 SCONF SCONF2 SCONF3 GCONF GCONF2 GCONF3 HERE "
-            "JHERE CALIB PAUSE DELAY AJMOVE IJMOVE ALMOVE ILMOVE HMOVE CMOVE1 CMOVE3 ADRIVE IDRIVE "
-            "SACC GACC $WAIT $DONE HANDOPEN HANDCLOSE GRASP HANDDEF HANDREF HANDCHG",
-}
-HOST_FUNCTIONS = [op(base + i, name, "see part 3 of the digest")
-                  for base, names in SYSTEM_AND_ROBOT_NAMES.items()
-                  for i, name in enumerate(names.split())]
+# System (EE) and robot-control (ED) functions (effects from part 3 of the digest). They have no
+# handler yet: the VM hands them to Host.call until the robot binding gives them one.
+HOST_FUNCTIONS = [
+    op(0xEE00, "TIME", "-- a:St"),
+    op(0xEE01, "DATE", "-- a:St"),
+    op(0xEE02, "CLOCK", "-- a:I4"),
+    op(0xEE03, "STIME", "a:St --"),
+    op(0xEE04, "SDATE", "a:St --"),
+    op(0xEE05, "CLRCLK", "--"),
+    op(0xEE06, "PACKTM", "h m s -- d:St"),
+    op(0xEE07, "UNPKTM", "a:St -- h m s"),
+    op(0xEE08, "PACKDT", "y mo d -- s:St"),
+    op(0xEE09, "UNPKDT", "a:St -- y mo d"),
+    op(0xEE0A, "CNFG", "port flow speed fmt --"),
+    op(0xEE0B, "DOUT", "port data --"),
+    op(0xEE0C, "DIN", "port -- data"),
+    op(0xEE0D, "IOWAIT", "port mask cond timeout -- masked tflag"),
+    op(0xEE0E, "ACT", "level --"),
+    op(0xEE0F, "ACTRS", "level --"),
+    op(0xEE10, "REACT", "--"),
+    op(0xEE11, "ACTCODE", "code level detproc --"),
+    op(0xEE12, "ACTION", "code handler --"),
+    op(0xEE13, "TIMER", "timeout --"),
+    op(0xEE14, "RTIMER", "--"),
+    op(0xEE15, "TACTION", "handler --"),
+    op(0xEE16, "FSTAT", "file -- status:I2"),
+    op(0xEE17, "OUTPUT", "file data --"),
+    op(0xEE18, "INPUT", "file -- data"),
+    op(0xEE19, "LOUTPUT", "file data --"),
+    op(0xEE1A, "LINPUT", "file #t -- data:t"),
+    op(0xEE1B, "FOPEN", "file mode --"),
+    op(0xEE1C, "FCLOSE", "file --"),
+    op(0xEE1D, "PUTC", "file ch --"),
+    op(0xEE1E, "GETC", "file -- ch:I2"),
+    op(0xEE1F, "DECODE1", "str #t -- value"),
+    op(0xEE20, "ENCODE1", "fmt b1 … bn n -- str"),
+    op(0xEE21, "DECODE2", "fmt str #c1 … #cn n -- count:I2"),
+    op(0xEE22, "ENCODE2", "fmt b1 … bn n -- str"),
+    op(0xED00, "JSPEED", "ratio -- err:I2"),
+    op(0xED01, "SPEED", "v -- err:I2"),
+    op(0xED02, "ACCEL1", "acc -- err:I2"),
+    op(0xED03, "ACCEL2", "t -- err:I2"),
+    op(0xED04, "DECEL1", "dec -- err:I2"),
+    op(0xED05, "DECEL2", "t -- err:I2"),
+    op(0xED06, "SCONF", "bits:I2 -- err:I2"),
+    op(0xED07, "SCONF2", "bits:I2 -- err:I2"),
+    op(0xED08, "SCONF3", "no:I2 val -- err:I2"),
+    op(0xED09, "GCONF", "-- bits:I2"),
+    op(0xED0A, "GCONF2", "-- bits:I2"),
+    op(0xED0B, "GCONF3", "no:I2 -- val"),
+    op(0xED0C, "HERE", "-- p:Pm"),
+    op(0xED0D, "JHERE", "-- j:Ar"),
+    op(0xED0E, "CALIB", "--"),
+    op(0xED0F, "PAUSE", "msg:St -- err:I2"),
+    op(0xED10, "DELAY", "t -- err:I2"),
+    op(0xED11, "AJMOVE", "p -- err:I2"),
+    op(0xED12, "IJMOVE", "p -- err:I2"),
+    op(0xED13, "ALMOVE", "p -- err:I2"),
+    op(0xED14, "ILMOVE", "p -- err:I2"),
+    op(0xED15, "HMOVE", "p -- err:I2"),
+    op(0xED16, "CMOVE1", "plane angle centre orient -- err:I2"),
+    op(0xED17, "CMOVE3", "via target -- err:I2"),
+    op(0xED18, "ADRIVE", "j:Ar -- err:I2"),
+    op(0xED19, "IDRIVE", "dj:Ar -- err:I2"),
+    op(0xED1A, "SACC", "acc -- err:I2"),
+    op(0xED1B, "GACC", "-- acc"),
+    op(0xED1C, "$WAIT", "timeout -- status:I2"),
+    op(0xED1D, "$DONE", "-- status:I2"),
+    op(0xED1E, "HANDOPEN", "--"),
+    op(0xED1F, "HANDCLOSE", "--"),
+    op(0xED20, "GRASP", "a1 … an n -- err:I2"),
+    op(0xED21, "HANDDEF", "a1 … an n hand -- err:I2"),
+    op(0xED22, "HANDREF", "hand -- b1 … bn n"),
+    op(0xED23, "HANDCHG", "hand -- err:I2"),
+]
 
 TABLE = VM_FUNCTIONS + HOST_FUNCTIONS
 BY_CODE = {row.code: row for row in TABLE}

@@ -30,3 +30,11 @@ def test_arithmetic_cases_cover_type_promotion() -> None:
     for mnemonic in ("ADD", "SUB", "MUL", "DIV", "PWR", "MOD", "IDIV", "EQU", "LEQ", "GEQ",
                      "LT", "GT", "AND", "OR"):
         assert any(":" in program or "." in program for program, _ in CASES[mnemonic]), mnemonic
+
+
+def test_system_and_robot_functions_are_rows_waiting_for_handlers() -> None:
+    host_rows = [row for row in opcodes.TABLE if row.code < 0xEF00]
+    assert [row.code for row in host_rows] == (list(range(0xEE00, 0xEE23))
+                                               + list(range(0xED00, 0xED24)))
+    assert all(row.handler is None and "--" in row.effect for row in host_rows)
+    assert len(opcodes.BY_CODE) == len(opcodes.TABLE) == 143 + 71
