@@ -31,9 +31,12 @@ class Code:
     size: int
 
 
+EXTENDED_PREFIX = 0xEB   # first byte of the 4-byte user codes decoded here (EA… is 2-byte)
+FIRST_TAG = SUPPRESS     # bytes F0–FF start data, lower bytes start function codes (§A.19)
+
+
 def code_width(first: int) -> int:
-    """2-byte codes, except the EB-prefixed 4-byte extended user codes (EA… is 2-byte here)."""
-    return 4 if first == 0xEB else 2
+    return 4 if first == EXTENDED_PREFIX else 2
 
 
 def read_function_code(reader: Reader, first: int) -> int:
@@ -49,7 +52,7 @@ def read_code(reader: Reader, depth: int) -> Code:
     first = reader.byte()
     if first == SUPPRESS:
         second = reader.byte()
-        if second >= 0xF0:
+        if second >= FIRST_TAG:
             item: object = reader.head(second)
         else:
             code = read_function_code(reader, second)
@@ -61,7 +64,7 @@ def read_code(reader: Reader, depth: int) -> Code:
         if not is_user_code(code):
             raise invalid("an indirect reference needs a user code", start)
         return Code(CodeKind.INDIRECT, code, start, reader.offset - start)
-    if first >= 0xF0:
+    if first >= FIRST_TAG:
         head = reader.head(first)
         if head.tag == INDIRECT:
             raise invalid("indirect reference without user code", start)

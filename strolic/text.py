@@ -9,7 +9,7 @@ import re
 
 from . import opcodes
 from .codec import Code, CodeKind, decode, decode_function, encode, encode_code
-from .codes import (ARRAY, I2, INDIRECT, LENGTH_TAGS, NUMERIC_TAGS, R8, REAL_TAGS, SUPPRESS,
+from .codes import (ARRAY, FUNCTION, I2, INDIRECT, LENGTH_TAGS, NUMERIC_TAGS, R8, REAL_TAGS, SUPPRESS,
                     TAGS_BY_NAME, Array, Function, FunctionCode, Num, Pose, Record, Str, TagHead,
                     Trn, UserCode, Vec, is_user_code, make_number, smallest_int, to_float32)
 from .errors import ExceptionKind as K, StrolicError
@@ -222,7 +222,7 @@ class Assembler:
         if word == "Rd":
             return Record(self.blob())
         if word == "Fn":
-            return value_from_data(TagHead(0xFD, 0), self.blob())
+            return value_from_data(TagHead(FUNCTION, 0), self.blob())
         if word == "Pm":
             self.expect("(")
             elements = []
