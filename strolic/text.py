@@ -9,9 +9,10 @@ import re
 
 from . import opcodes
 from .codec import Code, CodeKind, decode, decode_function, encode, encode_code
-from .codes import (ARRAY, FUNCTION, I2, INDIRECT, LENGTH_TAGS, NUMERIC_TAGS, R8, REAL_TAGS, SUPPRESS,
-                    TAGS_BY_NAME, Array, Function, FunctionCode, Num, Pose, Record, Str, TagHead,
-                    Trn, UserCode, Vec, is_user_code, make_number, smallest_int, to_float32)
+from .codes import (ARRAY, FUNCTION, I2, INDIRECT, LENGTH_TAGS, NUMERIC_TAGS, R8, REAL_TAGS,
+                    SUPPRESS, TAGS_BY_NAME, Array, Function, FunctionCode, Num, Pose, Record, Str,
+                    TagHead, Trn, UserCode, Vec, is_user_code, make_number, smallest_int,
+                    to_float32)
 from .errors import ExceptionKind as K, StrolicError
 from .literals import format_user_code, format_value
 from .values import MAX_NESTING, data_of, head_of, value_from_data
