@@ -21,44 +21,30 @@ def load_program(path: Path) -> bytes:
     return path.read_bytes()
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace) -> None:
+    """Run; the output stream goes to stderr, the final stack (--stack) to stdout."""
     vm = VM()
     try:
         main = vm.run(decode(load_program(Path(args.program))), budget=args.budget)
-    except StrolicError as error:
-        print(error.report(), file=sys.stderr)
-        return 1
     finally:
         for data in vm.host.output:
             print("output:", " ".join(format_code(code) for code in decode(data)), file=sys.stderr)
     if args.stack:
         for item in main.stack:
             print(format_value(item))
-    return 0
 
 
-def asm(args: argparse.Namespace) -> int:
-    try:
-        program = assemble(Path(args.input).read_text(encoding="utf-8"))
-    except StrolicError as error:
-        print(error.report(), file=sys.stderr)
-        return 1
-    Path(args.output).write_bytes(program)
-    return 0
+def asm(args: argparse.Namespace) -> None:
+    Path(args.output).write_bytes(assemble(Path(args.input).read_text(encoding="utf-8")))
 
 
-def dis(args: argparse.Namespace) -> int:
-    try:
-        sys.stdout.write(disassemble(Path(args.input).read_bytes(), offsets=args.offsets))
-    except StrolicError as error:
-        print(error.report(), file=sys.stderr)
-        return 1
-    return 0
+def dis(args: argparse.Namespace) -> None:
+    sys.stdout.write(disassemble(Path(args.input).read_bytes(), offsets=args.offsets))
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m strolic", description=__doc__)
-    commands = parser.add_subparsers(dest="command", required=True)
+def parser() -> argparse.ArgumentParser:
+    top = argparse.ArgumentParser(prog="python -m strolic", description=__doc__)
+    commands = top.add_subparsers(dest="command", required=True)
     run_parser = commands.add_parser("run", help="run a program (.sasm text or raw code)")
     run_parser.add_argument("program")
     run_parser.add_argument("--stack", action="store_true", help="print the final data stack")
@@ -74,8 +60,21 @@ def main(argv: list[str] | None = None) -> int:
     dis_parser.add_argument("--offsets", action="store_true",
                             help="end each line with a comment giving the code's byte offset")
     dis_parser.set_defaults(action=dis)
-    args = parser.parse_args(argv)
-    return args.action(args)
+    return top
+
+
+def main(argv: list[str] | None = None) -> int:
+    """0 on a normal end; 1 with the report on a STROLIC exception; 2 when a file fails."""
+    args = parser().parse_args(argv)
+    try:
+        args.action(args)
+    except StrolicError as error:
+        print(error.report(), file=sys.stderr)
+        return 1
+    except OSError as error:
+        print(f"strolic: {error}", file=sys.stderr)
+        return 2
+    return 0
 
 
 if __name__ == "__main__":

@@ -84,3 +84,8 @@ def test_asm_and_dis_report_bad_input(tmp_path: Path) -> None:
     (tmp_path / "bad.stl").write_bytes(b"\xf3")
     result = strolic("dis", str(tmp_path / "bad.stl"))
     assert result.returncode != 0 and "invalid code" in result.stderr
+
+
+def test_missing_file_is_reported_without_a_traceback(tmp_path: Path) -> None:
+    result = strolic("run", str(tmp_path / "missing.sasm"))
+    assert result.returncode == 2 and "Traceback" not in result.stderr

@@ -203,3 +203,9 @@ def test_cyclic_process_runs_every_period_on_the_host_clock() -> None:
     assert [item.value for item in main.stack] == [2, 3]     # waiting for its next start
     assert host.output == [bytes([0xF1, n]) for n in (1, 2, 3)]
     assert host.time == pytest.approx(0.2)      # started at 0, then at 0.1 and 0.2
+
+
+def test_variables_persist_between_runs_of_one_vm() -> None:
+    vm = VM()
+    vm.run(assemble(".name x %1000 VAR #x DCL #x 41 STORE"))
+    assert [item.value for item in vm.run(assemble("%1000 INC")).stack] == [42]
