@@ -198,7 +198,8 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
              ("#x Vec(1 2 3) STORE #x 2 9 EMBE x", ["Vec(1.0 2.0 9.0)"]),
              ("#x Ar[I2 1 2 3] STORE #x 1 9 EMBE", TYPE), ("#x 5 STORE #x 0 1 EMBE", TYPE),
              ('#x "AB" STORE #x 0 "C" EMBE', TYPE),
-             ("#x Ar[I2 1] STORE #x 1 I2:9 EMBE", AREA), ("#x 0 1 EMBE", UNDEF)],
+             ("#x Ar[I2 1] STORE #x 1 I2:9 EMBE", AREA), ("#x Ar[I2 1] STORE #x -1 I2:9 EMBE", AREA),
+             ("#x 0 1 EMBE", UNDEF)],
     # ---- branches and functions ------------------------------------------------------------------------------
     "BRA": [("#f Fn{ 1 >skip BRA 2 skip: 3 END } STORE f", ["1", "3"]),
             ("#f Fn{ 0 top: INC DUP 5 LT >out BRF >top BRA out: END } STORE f", ["5"]),
@@ -230,7 +231,7 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
     "NPUSH": [("#x 1 STORE 1 NESTIN VAR #x DCL #x 2 STORE #x 0 NPUSH #x 1 NPUSH", ["1", "2"]),
               ("#x 5 NPUSH", UNDEF), ("1 NESTIN #x 1 NPUSH", UNDEF)],
     "NPOP": [("#x 1 STORE 1 NESTIN VAR #x DCL 9 #x 0 NPOP NESTOUT x", ["9"]),
-             ("9 #x 5 NPOP", UNDEF)],
+             ("9 #x 5 NPOP", UNDEF), ("1 NESTIN 9 #x 1 NPOP", UNDEF)],
     "DCL": [("VAR #%2000 DCL #%2000 5 STORE %2000", ["5"]),
             ("VAR #%2000 DCL #%2000 1 STORE VAR #%2000 DCL #%2000 2 STORE %2000 "
              "VAR #%2000 FREE %2000", ["2", "1"]),
