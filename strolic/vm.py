@@ -33,6 +33,8 @@ class VM:
         self._compiled: dict[bytes, list] = {}
         self.generation = 0                # bumped whenever waiting processes may proceed
         self.executed = 0                  # instructions of the current run (budget)
+        self.budget: int | None = None
+        self.main: Process | None = None   # process 0, the program of the current run
         self.reset()
 
     # ---- state ----------------------------------------------------------------------------------
@@ -150,7 +152,7 @@ class VM:
             proc.state = State.DONE
 
     def _execute(self, proc: Process, limit: int) -> None:
-        proc.last_run = self.executed
+        """The dispatch loop: up to ``limit`` instructions of ``proc`` (fewer if it waits/ends)."""
         stack = proc.stack
         frame = proc.frame
         codes = frame.codes
