@@ -125,7 +125,8 @@ class ArmCore:
         self.hard_limit_joint = np.degrees(np.stack([self.kin.lower, self.kin.upper], axis=1))
         self.hard_max_speed_joint = np.degrees(self.kin.velocity)
         q0 = self._start_joints(c.initial_joints_deg, "initial_joints_deg")
-        self.home = np.degrees(self._start_joints(c.home_joints_deg, "home_joints_deg"))
+        self._start_joints(c.home_joints_deg, "home_joints_deg")
+        self.home = np.array(c.home_joints_deg, float)
         world.reset_arm(q0)
         self.finger_max = world.limits[GRIPPER_JOINTS[0]].upper
         # settings (units of the ports)
@@ -537,9 +538,10 @@ class ArmCore:
             raise Refused(R.STATUS_ERR, f"the speed ratio is 0 %: set it with {setter} first")
 
     def _check_idle(self, name: str) -> None:
-        if self.device.busy:
-            raise Refused(R.STATUS_ERR, f"{name} is refused while the arm moves or has motions "
-                                        "queued (wait, or stop first)")
+        """The spec refuses these while moving (state bit 0x02) or alarmed; paused is not moving."""
+        if self.state_word() & STATE_MOVING:
+            raise Refused(R.STATUS_ERR, f"{name} is refused while the arm moves "
+                                        "(wait, pause or stop first)")
         if self._alarms:
             raise Refused(R.STATUS_ERR, f"{name} is refused while an alarm is active")
 
