@@ -51,6 +51,7 @@ SETTER = (R.VALUE_ERR,)
 MOVE = (R.STATUS_ERR, R.VALUE_ERR, R.FULL_MOTION_QUEUE_ERR, R.NOT_SV_ON_ERR)
 
 CARTESIAN_WATCH_TOLERANCE_MM = 0.1
+REL_ELBOW_CLEARANCE = math.sin(math.radians(10.0))
 JOINT_WATCH_TOLERANCE_DEG = 1e-6
 
 
@@ -632,10 +633,26 @@ class ArmCore:
             return ArmMotion(path, timing, start.finger, start.finger, ramp, "joint")
         return self._submit(plan, label)
 
+    def _elbow_goal(self, start_q: np.ndarray, flange: np.ndarray, psi: float | None,
+                    turn: float) -> tuple[float | None, float]:
+        """(psi, turn) for the planners. Abs: psi as given. Rel: psi = the start's arm angle +
+        turn, except where the start or the target is near the arm angle's undefined direction
+        (wrist left or right of the shoulder): there the elbow is carried along without twist
+        and turned by `turn` (psi None)."""
+        if psi is not None:
+            return psi, 0.0
+        kin = self.kin
+        u0 = kin.elbow_direction(start_q)[0]
+        w = kin.wrist_of(flange) - kin.shoulder
+        u1 = w / max(float(np.linalg.norm(w)), 1e-12)
+        if min(kin.reference_strength(u0), kin.reference_strength(u1)) > REL_ELBOW_CLEARANCE:
+            return kin.angle_of(*kin.elbow_direction(start_q)) + turn, 0.0
+        return None, turn
+
     def _queue_ptp_cartesian(self, target_of: Callable[[np.ndarray], np.ndarray], label: str, *,
                              psi: float | None = None, turn: float = 0.0) -> dict:
         """A PTP move to the control-point pose target_of(start pose), with the elbow at arm
-        angle `psi`, or (Rel) carried over from the start and turned by `turn` (rad)."""
+        angle `psi`, or (Rel) turned by `turn` (rad) from where it starts."""
         frames, kin = self.frames, self.kin
         lo, hi = np.radians(self.soft_limit_joint[:, 0]), np.radians(self.soft_limit_joint[:, 1])
 
@@ -643,13 +660,14 @@ class ArmCore:
             target = target_of(frames.tool_of(kin.flange(start.joints)))
             self._check_cartesian_positions(target[None, :3, 3] * 1000.0, label)
             flange = frames.flange_of(target)
+            goal_psi, goal_turn = self._elbow_goal(start.joints, flange, psi, turn)
             try:
-                if psi is not None:
-                    return kin.solve(flange, start.joints, psi=psi, lower=lo, upper=hi)
+                if goal_psi is not None:
+                    return kin.solve(flange, start.joints, psi=goal_psi, lower=lo, upper=hi)
                 u0, n0 = kin.elbow_direction(start.joints)
                 w = kin.wrist_of(flange) - kin.shoulder
                 u1 = w / max(float(np.linalg.norm(w)), 1e-12)
-                elbow = rotate_about(u1, turn) @ kin.transport(n0, u0, u1)
+                elbow = rotate_about(u1, goal_turn) @ kin.transport(n0, u0, u1)
                 return kin.solve(flange, start.joints, elbow_dir=elbow, lower=lo, upper=hi)
             except Unreachable as e:
                 raise value_error(f"{label}: {e}") from None
@@ -658,7 +676,7 @@ class ArmCore:
     def _queue_cartesian(self, path_of: Callable[[np.ndarray], LinePath], label: str, *,
                          psi: float | None = None, turn: float = 0.0) -> dict:
         """A CP move along path_of(start pose); the elbow ends at arm angle `psi`, or (Rel) is
-        carried along and turned by `turn` (rad)."""
+        turned by `turn` (rad) from where it starts."""
         frames = self.frames
         v, w = self.max_speed_cartesian
         ratio = self.speed_cartesian / 100.0
@@ -676,8 +694,11 @@ class ArmCore:
             ss = np.linspace(0.0, 1.0, 1 + max(2, math.ceil(path.length / 0.002)))
             self._check_cartesian_positions(np.array([path.position(s) for s in ss]) * 1000.0,
                                             label)
+            goal_psi, goal_turn = self._elbow_goal(start.joints, frames.flange_of(path.pose(1.0)),
+                                                   psi, turn)
             try:
-                result = self.planner.plan(path, frames, start.joints, limits, psi=psi, turn=turn)
+                result = self.planner.plan(path, frames, start.joints, limits, psi=goal_psi,
+                                           turn=goal_turn)
             except Unreachable as e:
                 raise value_error(f"{label}: {e}") from None
             dense = np.linspace(0.0, 1.0, 4 * len(result.path.ss))

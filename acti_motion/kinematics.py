@@ -12,9 +12,9 @@ puts the elbow on that side (in the start posture, wrist above the shoulder: the
 forward; reaching forward: the elbow below the line), ψ = ±180° on the other. The reference is
 undefined only where the wrist is straight to the left or right of the shoulder (within
 `LATERAL_CONE`; there ẑ × u takes its place), a place this arm rarely reaches through; the
-start posture and the forward and upward workspace are far from it. Relative moves do not use
-the reference at all: they carry the elbow along without twist (`transport`) and turn it by the
-requested amount.
+start posture and the forward and upward workspace are far from it. Near that direction
+relative moves do not use the reference: they carry the elbow along without twist
+(`transport`) and turn it by the requested amount.
 """
 from __future__ import annotations
 
@@ -148,6 +148,11 @@ class ArmKinematics:
                 e1 = e1 / n
                 return e1, np.cross(u, e1)
         raise AssertionError("unreachable: y and z cannot both be parallel to u")
+
+    @staticmethod
+    def reference_strength(u: np.ndarray) -> float:
+        """|ŷ × u|: 1 far from the arm angle's undefined direction (u = ±ŷ), 0 on it."""
+        return float(math.hypot(u[0], u[2]))
 
     def elbow_direction(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(u, n): the unit S→W and the unit direction from the elbow circle's centre to E."""
