@@ -44,8 +44,11 @@ class World:
         p.setGravity(0, 0, -9.81)
         p.setTimeStep(time_step)
         self.plane = p.loadURDF("plane.urdf")
+        # Implicit cylinders: by default PyBullet turns a URDF cylinder into a convex hull, on which
+        # the wheels roll ~2 % farther than 2πr per turn (and the base pitches): odometry was off.
         self.robot = p.loadURDF(urdf_path, [0, 0, 0.1], useFixedBase=False,
-                                flags=pybullet.URDF_USE_INERTIA_FROM_FILE)
+                                flags=pybullet.URDF_USE_INERTIA_FROM_FILE
+                                | pybullet.URDF_USE_IMPLICIT_CYLINDER)
         self._joint = {}
         self._link = {}
         self.limits: dict[str, JointLimit] = {}

@@ -48,7 +48,10 @@ def test_move_forward_ends_within_5_mm(base, executor, distance):  # noqa: F811
     base.set_servo(True)
     assert base.move_forward(distance).ok
     assert state(base) == VehicleState.BUSY
+    x0 = executor.world.base_pose()[0]
     run_until(executor, lambda: not base.device.busy, 10.0)
     x, y, theta = base.get_position().values["pos"]
     assert abs(x - distance) < 5.0 and abs(y) < 5.0 and abs(theta) < 0.5
     assert state(base) == VehicleState.READY
+    # wheel odometry agrees with the ground truth (the wheels roll on true cylinders)
+    assert abs(1000.0 * (executor.world.base_pose()[0] - x0) - distance) < 2.0
