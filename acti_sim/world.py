@@ -61,9 +61,12 @@ class World:
         # Free all motors; every driven joint gets an explicit motor below.
         for j in self._joint.values():
             p.setJointMotorControl2(self.robot, j, pybullet.VELOCITY_CONTROL, force=0)
+        # Sprung casters: frictionless, and compliant so that the driven wheels carry the weight
+        # (rigid casters took ~90 % of it and the wheels slipped: odometry drifted in turns).
         for name in CASTER_LINKS:
             p.changeDynamics(self.robot, self._link[name], lateralFriction=0.0,
-                             rollingFriction=0.0, spinningFriction=0.0)
+                             rollingFriction=0.0, spinningFriction=0.0,
+                             contactStiffness=5.0e4, contactDamping=3.0e3)
         for name in WHEEL_JOINTS:
             p.changeDynamics(self.robot, self._joint[name], lateralFriction=1.5)
         self._arm_ids = [self._joint[n] for n in ARM_JOINTS]
