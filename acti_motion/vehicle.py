@@ -16,7 +16,7 @@ from enum import IntEnum
 from typing import Any, Callable
 
 from acti_motion.base import (BrakeMotion, Chain, Odometry, Path, Pose2D, TrackedBaseMotion,
-                              arc, line, turn, wrap_angle)
+                              arc, line, turn, velocity_path, wrap_angle)
 from acti_motion.executor import Device, MotionExecutor
 from acti_motion.replies import Refused, ReturnCode, answers, finite_number
 from acti_motion.vehicle_alarms import AlarmCode, Alarms, AlarmType, Kind
@@ -27,6 +27,7 @@ from acti_sim.world import World
 IF_VERSION = "RTC VehicleService interface: ver.2.0.0"
 FIRMWARE_VERSION = "Ver.1.0.0.1"
 WHEEL_AXES = (0, 1)                      # getServoStatus ids: left, right wheel motor
+VELOCITY_DRIVEN = ("move_jog", "joystick")  # motions driven by a velocity, not a target
 
 
 class VehicleState(IntEnum):
@@ -70,6 +71,9 @@ class VehicleConfig:
     default_accel_translation: float = 500.0
     default_accel_rotation: float = 90.0
     jog_timeout: int = 500                       # ms
+    joy_axis_linear: int = 1                     # sensor_msgs/Joy axis for forward speed …
+    joy_axis_angular: int = 0                    # … and for the yaw rate (left stick)
+    joy_enable_button: int = -1                  # a button that must be held (-1: none)
     io_config: str = ""                          # I/O ids (YAML); "" = config/vehicle_io.yaml
     battery_capacity_wh: float = 960.0
     battery_charge: float = 1.0                  # state of charge at start-up, 0 … 1
@@ -213,11 +217,11 @@ class VehicleCore:
 
     def state_string(self, s: VehicleState) -> str:
         """Table 7's string: Warning-### and Alarm-### carry the code."""
-        if s == VehicleState.ALARM:
-            return f"Alarm-{self.alarms.first(AlarmType.FAULT, Kind.CONTACT).code:03d}"
-        if s == VehicleState.WARNING:
-            return f"Warning-{self._latest_warning().code:03d}"
-        return STATE_STRINGS[s]
+        alarm = (self.alarms.first(AlarmType.FAULT, Kind.CONTACT) if s == VehicleState.ALARM else
+                 self._latest_warning() if s == VehicleState.WARNING else None)
+        if alarm is None:                  # also when it was cleared meanwhile by another thread
+            return STATE_STRINGS[s]
+        return f"{STATE_STRINGS[s]}-{alarm.code:03d}"
 
     def _latest_warning(self):
         warnings = [a for a in self.alarms.active() if a.type == AlarmType.WARNING]
@@ -444,6 +448,60 @@ class VehicleCore:
         limits = self._limits()
         return self._submit(lambda start: arc(start, cy / 1000.0, angle, limits), "move_circular_rel")
 
+    @command
+    def move_jog(self, x_vel: float, y_vel: float, theta_vel: float) -> dict:
+        """Drive at (x_vel, theta_vel) until jog_timeout ms after the last call, then decelerate.
+        Each velocity is signed (backwards, clockwise) and at most the unit's limit; y_vel must
+        be 0 on a differential drive. A jog starts on an idle base or updates the running jog."""
+        c = self.config
+        vx, vy, vth = (finite_number(v, n) for v, n in zip((x_vel, y_vel, theta_vel),
+                                                            ("x_vel", "y_vel", "theta_vel")))
+        if vy != 0.0:
+            raise VehicleRefused(AlarmCode.NOT_HOLONOMIC,
+                                 f"y_vel is {vy:g} mm/s: a differential drive cannot move sideways")
+        for value, limit, name, unit in ((vx, c.velocity_limit_translation, "x_vel", "mm/s"),
+                                         (vth, c.velocity_limit_rotation, "theta_vel", "degree/s")):
+            if abs(value) > limit:
+                raise invalid(f"{name} is {value:g} {unit}: the unit's limit is {limit:g} {unit}")
+        self._require(SERVO_ON, "move_jog")
+        (at, ar) = self.acceleration
+        return self._drive((vx / 1000.0, math.radians(vth)), self.jog_timeout / 1000.0,
+                           (at / 1000.0, math.radians(ar)), "move_jog")
+
+    @command
+    def set_joystick(self, on_off: bool) -> None:
+        """Joystick on: its input drives the base (within the velocity and acceleration settings).
+        Off while it drives: decelerate at the maximum acceleration, then Ready."""
+        self.joystick = bool(on_off)
+        cur = self.device.current
+        if not on_off and cur is not None and cur.label == "joystick":
+            c = self.config
+            self._drive((0.0, 0.0), 0.0, (c.accel_limit_translation / 1000.0,
+                                          math.radians(c.accel_limit_rotation)), "joystick")
+
+    def joy_input(self, axes: list[float], buttons: list[int]) -> bool:
+        """A sensor_msgs/Joy sample (not an IDL operation): full stick = the velocity setting.
+        Ignored (False) with the joystick off, the servo off, an alarm, or moves in the queue."""
+        c = self.config
+        with self.lock:
+            if not self.joystick or self.state() not in SERVO_ON:
+                return False
+            if c.joy_enable_button >= 0 and not (c.joy_enable_button < len(buttons)
+                                                 and buttons[c.joy_enable_button]):
+                axes = []
+
+            def axis(i: int) -> float:
+                value = axes[i] if 0 <= i < len(axes) else 0.0
+                return min(1.0, max(-1.0, value)) if math.isfinite(value) else 0.0
+            (vt, vr), (at, ar) = self.velocity, self.acceleration
+            target = (axis(c.joy_axis_linear) * vt / 1000.0, math.radians(axis(c.joy_axis_angular) * vr))
+            try:
+                self._drive(target, self.jog_timeout / 1000.0, (at / 1000.0, math.radians(ar)),
+                            "joystick")
+            except Refused:
+                return False
+            return True
+
     # --- helpers ----------------------------------------------------------------------------
     def _require(self, allowed: tuple[VehicleState, ...], operation: str) -> None:
         s = self.state()
@@ -473,6 +531,37 @@ class VehicleCore:
         if motion_id is None:
             raise VehicleRefused(AlarmCode.QUEUE_FULL,
                                  f"the motion queue is full ({self.device.capacity} motions)")
+        self._accepted_motion()
+        return {"motion_id": motion_id}
+
+    def _drive(self, target: tuple[float, float], hold: float, accel: tuple[float, float],
+               label: str) -> dict:
+        """Velocity drive: re-plan the running jog/joystick motion from where its reference is
+        now (speed continuous), or start one on an idle base; refused behind queued moves."""
+        odometry = self.odometry
+
+        def plan(start: Pose2D, v0: float = 0.0, w0: float = 0.0) -> Path:
+            return velocity_path(start, v0, w0, target, hold, accel)
+
+        def update(device: Device) -> int | None:
+            cur = device.current
+            if cur is not None and not device.queue and not device.stopping \
+                    and cur.label in VELOCITY_DRIVEN:
+                t = device.t
+                cur.motion.splice(t, plan(cur.motion.at(t), *cur.motion.reference_twist(t)))
+                cur.label = label
+                return cur.id
+            if device.busy and not (cur is not None and device.stopping and not device.queue):
+                raise VehicleRefused(AlarmCode.WRONG_STATE,
+                                     f"the base is busy with queued moves: {label} drives only an "
+                                     "idle base (wait, or call stop)")
+            return None
+        motion_id = self.device.edit(update)
+        if motion_id is None:
+            motion_id = self.device.submit(
+                lambda start: TrackedBaseMotion(odometry, plan(start), label), label)
+            if motion_id is None:
+                raise VehicleRefused(AlarmCode.QUEUE_FULL, "the motion queue is full")
         self._accepted_motion()
         return {"motion_id": motion_id}
 

@@ -1,9 +1,13 @@
 """vehicle_node as a real process over DDS: the operation table, nested messages both ways,
 refusals that leave the node up."""
 import math
+import time
 
 from acti_msgs import srv
-from acti_msgs.msg import VehicleAlarm, VehiclePoint, VehiclePosition, VehicleVelocity
+from acti_msgs.msg import VehicleAlarm, VehiclePoint, VehiclePosition, VehicleStatus, VehicleVelocity
+from diagnostic_msgs.msg import DiagnosticArray
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
 
 from ros_harness import node_fixture, wait_until
 from vehicle_node.operations import OPERATIONS
@@ -91,4 +95,52 @@ def test_moves_over_dds(ros, vehicle):
     assert math.hypot(pos.x, pos.y - 800.0) < 5.0 and abs(abs(pos.theta) - 180.0) < 0.5
     r = call(ros, "move_circular_rel", center_point=VehiclePoint(x=10.0, y=400.0), theta=90.0)
     assert not r.success and "x = 0" in r.message
+    assert vehicle.alive()
+
+
+def spin_until(ros, predicate, timeout):
+    """Spin the client (subscriptions) until predicate() holds."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if predicate():
+            return True
+        ros.executor.spin_once(timeout_sec=0.05)
+    return predicate()
+
+
+def test_topics_state_diagnostics_odom_and_cmd_vel(ros, vehicle):
+    got = {"state": [], "diag": [], "odom": [], "truth": []}
+    subs = [ros.node.create_subscription(VehicleStatus, BASE + "state", got["state"].append, 10),
+            ros.node.create_subscription(DiagnosticArray, "/diagnostics", got["diag"].append, 10),
+            ros.node.create_subscription(Odometry, "/odom", got["odom"].append, 10),
+            ros.node.create_subscription(Odometry, BASE + "ground_truth", got["truth"].append, 10)]
+    cmd = ros.node.create_publisher(Twist, "/cmd_vel", 10)
+    try:
+        assert call(ros, "set_power", on_off=True).success and call(ros, "set_servo", on_off=True).success
+        assert spin_until(ros, lambda: all(got.values()), 10.0)
+        status = got["state"][-1]
+        assert (status.state, status.msg, status.power, status.servo) == (0x010, "Ready", True, True)
+        names = [s.name for s in got["diag"][-1].status]
+        assert names == ["vehicle_node: battery", "vehicle_node: alarms"]
+        assert got["diag"][-1].status[0].message.endswith(" V")
+        p0 = got["odom"][-1].pose.pose.position
+        twist = Twist()
+        twist.linear.x = 0.2
+        deadline = time.monotonic() + 1.0                      # 1 s wall = 4 s simulated
+        while time.monotonic() < deadline:
+            cmd.publish(twist)
+            ros.executor.spin_once(timeout_sec=0.05)
+        assert spin_until(ros, lambda: got["state"][-1].state == 0x011, 2.0)   # Busy
+        assert spin_until(ros, lambda: got["state"][-1].state == 0x010, 5.0)   # stopped by itself
+        odom = got["odom"][-1]
+        assert odom.header.frame_id == "odom" and odom.child_frame_id == "base_link"
+        p1 = odom.pose.pose.position
+        moved = math.hypot(p1.x - p0.x, p1.y - p0.y)
+        assert 0.3 < moved < 1.2                                 # metres (REP 103)
+        truth = got["truth"][-1].pose.pose.position
+        assert math.hypot(truth.x - p1.x, truth.y - p1.y) < 0.05
+    finally:
+        for s in subs:
+            ros.node.destroy_subscription(s)
+        ros.node.destroy_publisher(cmd)
     assert vehicle.alive()
