@@ -17,6 +17,7 @@ from typing import Any, Callable
 
 from acti_motion.base import (BrakeMotion, Chain, Odometry, Path, Pose2D, TrackedBaseMotion,
                               arc, line, turn, velocity_path, wrap_angle)
+from acti_motion.cruise import CruiseMotion
 from acti_motion.executor import Device, MotionExecutor
 from acti_motion.replies import Refused, ReturnCode, answers, finite_number
 from acti_motion.vehicle_alarms import AlarmCode, Alarms, AlarmType, Kind
@@ -449,6 +450,31 @@ class VehicleCore:
         return self._submit(lambda start: arc(start, cy / 1000.0, angle, limits), "move_circular_rel")
 
     @command
+    def move_cruise_abs(self, cruise_point: Any) -> dict:
+        """Pass cruise_point (odometry frame) smoothly: points given while the base cruises are
+        appended to its path, so it stops only at the last; TOPP-RA times the path within the
+        velocity and acceleration settings."""
+        px, py = (finite_number(v, f"cruise_point.{f}") for v, f in zip(cruise_point, "xy"))
+        self._require(SERVO_ON, "move_cruise_abs")
+        point, limits, odometry = (px / 1000.0, py / 1000.0), self._limits(), self.odometry
+
+        def extend(device: Device) -> int | None:
+            last = device.queue[-1] if device.queue else device.current
+            if last is None or last.label != "move_cruise_abs":
+                return None
+            running = last is device.current
+            if running and device.stopping:
+                return None
+            last.motion.limits = limits
+            return last.id if last.motion.add_point(point, device.t if running else 0.0) else None
+        motion_id = self.device.edit(extend)
+        if motion_id is not None:
+            self._accepted_motion()
+            return {"motion_id": motion_id}
+        return self._submit_motion(lambda start: CruiseMotion(odometry, start, point, limits),
+                                   "move_cruise_abs")
+
+    @command
     def move_jog(self, x_vel: float, y_vel: float, theta_vel: float) -> dict:
         """Drive at (x_vel, theta_vel) until jog_timeout ms after the last call, then decelerate.
         Each velocity is signed (backwards, clockwise) and at most the unit's limit; y_vel must
@@ -525,9 +551,13 @@ class VehicleCore:
         return vt / 1000.0, math.radians(vr), at / 1000.0, math.radians(ar)
 
     def _submit(self, plan: Callable[[Pose2D], Path], label: str) -> dict:
+        """Queue a tracked motion along plan(start of the motion)."""
         odometry = self.odometry
-        motion_id = self.device.submit(lambda start: TrackedBaseMotion(odometry, plan(start), label),
-                                       label)
+        return self._submit_motion(lambda start: TrackedBaseMotion(odometry, plan(start), label),
+                                   label)
+
+    def _submit_motion(self, make: Callable[[Pose2D], Any], label: str) -> dict:
+        motion_id = self.device.submit(make, label)
         if motion_id is None:
             raise VehicleRefused(AlarmCode.QUEUE_FULL,
                                  f"the motion queue is full ({self.device.capacity} motions)")
@@ -538,8 +568,6 @@ class VehicleCore:
                label: str) -> dict:
         """Velocity drive: re-plan the running jog/joystick motion from where its reference is
         now (speed continuous), or start one on an idle base; refused behind queued moves."""
-        odometry = self.odometry
-
         def plan(start: Pose2D, v0: float = 0.0, w0: float = 0.0) -> Path:
             return velocity_path(start, v0, w0, target, hold, accel)
 
@@ -558,10 +586,7 @@ class VehicleCore:
             return None
         motion_id = self.device.edit(update)
         if motion_id is None:
-            motion_id = self.device.submit(
-                lambda start: TrackedBaseMotion(odometry, plan(start), label), label)
-            if motion_id is None:
-                raise VehicleRefused(AlarmCode.QUEUE_FULL, "the motion queue is full")
+            return self._submit(plan, label)
         self._accepted_motion()
         return {"motion_id": motion_id}
 
