@@ -216,19 +216,6 @@ class Chain:
         return path.twist(tau)
 
 
-class Truncated:
-    """The first `duration` seconds of a path (the rest replaced by what follows in a Chain)."""
-
-    def __init__(self, path: Path, duration: float) -> None:
-        self.path, self.duration = path, duration
-
-    def pose(self, t: float) -> Pose2D:
-        return self.path.pose(min(t, self.duration))
-
-    def twist(self, t: float) -> tuple[float, float]:
-        return self.path.twist(t) if 0.0 <= t < self.duration else (0.0, 0.0)
-
-
 class Moved:
     """A path seen from another frame: pose' = frame ∘ pose (setPosition moves the odometry frame)."""
 
@@ -241,6 +228,28 @@ class Moved:
 
     def twist(self, t: float) -> tuple[float, float]:
         return self.path.twist(t)
+
+
+def straight_to(start: Pose2D, goal: Pose2D, limits: tuple[float, float, float, float],
+                wrap_final: bool) -> Chain:
+    """A differential drive's straight move: turn toward the goal, drive, turn to its heading.
+    A goal behind the base is reached backwards (the smaller turn). `wrap_final` turns the
+    shorter way to an absolute heading; otherwise the heading change is taken as given."""
+    dx, dy = goal.x - start.x, goal.y - start.y
+    dist = math.hypot(dx, dy)
+    paths: list[Path] = []
+    here = start
+    if dist > 1e-5:
+        bearing = wrap_angle(math.atan2(dy, dx) - start.theta)
+        if abs(bearing) > math.pi / 2:
+            bearing, dist = wrap_angle(bearing - math.pi), -dist
+        paths.append(turn(here, bearing, limits))
+        here = Pose2D(here.x, here.y, here.theta + bearing)
+        paths.append(line(here, dist, limits))
+        here = here.forward(dist)
+    final = goal.theta - here.theta
+    paths.append(turn(here, wrap_angle(final) if wrap_final else final, limits))
+    return Chain(paths, start)
 
 
 class SampledPath:

@@ -18,7 +18,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from acti_motion.base import (Chain, Odometry, Path, Pose2D, SampledPath, TrackedBaseMotion,
-                              turn, wrap_angle)
+                              straight_to, turn, velocity_path, wrap_angle)
 
 SAMPLE_DT = 0.005            # s between samples of the timed path
 DENSE_STEP = 0.002           # m between samples of the geometric path
@@ -167,3 +167,25 @@ class CruiseMotion(TrackedBaseMotion):
         self.from_rest, self.curve_from = False, 0.0
         self.via_times = plan.via_times
         return True
+
+
+AHEAD = math.radians(60.0)            # a new goal within this bearing is reached on a curve
+
+
+def transition_to(start: Pose2D, v0: float, w0: float, goal: Pose2D,
+                  limits: tuple[float, float, float, float]) -> Path:
+    """moveContinuousRel's path from the reference state (start, v0, w0) to `goal`, speed
+    continuous: from rest the straight move; moving forward toward a goal ahead, a smooth curve
+    onto it (TOPP-RA from v0) and a turn to its heading; otherwise brake, then the straight move."""
+    if abs(v0) < 1e-3 and abs(w0) < 1e-3:
+        return straight_to(start, goal, limits, False)
+    bearing = wrap_angle(math.atan2(goal.y - start.y, goal.x - start.x) - start.theta)
+    if v0 > 0.0 and abs(bearing) < AHEAD and abs(w0) < limits[1]:
+        plan = plan_curve(start, [(goal.x, goal.y)], limits, v0)
+        if plan is not None:
+            end = plan.path.pose(plan.path.duration)
+            final = turn(end, wrap_angle(goal.theta - end.theta), limits)
+            return Chain([plan.path, final], start)
+    brake = velocity_path(start, v0, w0, (0.0, 0.0), 0.0, (limits[2], limits[3]))
+    rest = brake.pose(brake.duration)
+    return Chain([brake, straight_to(rest, goal, limits, False)], start)

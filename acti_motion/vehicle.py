@@ -15,9 +15,9 @@ from dataclasses import dataclass
 from enum import IntEnum
 from typing import Any, Callable
 
-from acti_motion.base import (BrakeMotion, Chain, Odometry, Path, Pose2D, TrackedBaseMotion,
-                              arc, line, turn, velocity_path, wrap_angle)
-from acti_motion.cruise import CruiseMotion
+from acti_motion.base import (BrakeMotion, Odometry, Path, Pose2D, TrackedBaseMotion, arc, line,
+                              straight_to, turn, velocity_path)
+from acti_motion.cruise import CruiseMotion, transition_to
 from acti_motion.executor import Device, MotionExecutor
 from acti_motion.replies import Refused, ReturnCode, answers, finite_number
 from acti_motion.vehicle_alarms import AlarmCode, Alarms, AlarmType, Kind
@@ -145,28 +145,6 @@ def finite_pose(pos: Any, name: str = "pos") -> Pose2D:
     """A Position (mm, mm, degree) as a Pose2D (m, m, rad)."""
     x, y, theta = (finite_number(v, f"{name}.{f}") for v, f in zip(pos, ("x", "y", "theta")))
     return Pose2D(x / 1000.0, y / 1000.0, math.radians(theta))
-
-
-def straight_to(start: Pose2D, goal: Pose2D, limits: tuple[float, float, float, float],
-                wrap_final: bool) -> Chain:
-    """A differential drive's straight move: turn toward the goal, drive, turn to its heading.
-    A goal behind the base is reached backwards (the smaller turn). `wrap_final` turns the
-    shorter way to an absolute heading; otherwise the heading change is taken as given."""
-    dx, dy = goal.x - start.x, goal.y - start.y
-    dist = math.hypot(dx, dy)
-    paths: list[Path] = []
-    here = start
-    if dist > 1e-5:
-        bearing = wrap_angle(math.atan2(dy, dx) - start.theta)
-        if abs(bearing) > math.pi / 2:
-            bearing, dist = wrap_angle(bearing - math.pi), -dist
-        paths.append(turn(here, bearing, limits))
-        here = Pose2D(here.x, here.y, here.theta + bearing)
-        paths.append(line(here, dist, limits))
-        here = here.forward(dist)
-    final = goal.theta - here.theta
-    paths.append(turn(here, wrap_angle(final) if wrap_final else final, limits))
-    return Chain(paths, start)
 
 
 class VehicleCore:
@@ -473,6 +451,35 @@ class VehicleCore:
             return {"motion_id": motion_id}
         return self._submit_motion(lambda start: CruiseMotion(odometry, start, point, limits),
                                    "move_cruise_abs")
+
+    @command
+    def move_continuous_rel(self, pos: Any) -> dict:
+        """Go to pos relative to the base. Given again while the base is on its way, the new
+        target (relative to where the base is then) replaces the old one and the base turns onto
+        it with continuous velocity; behind other queued moves it waits its turn."""
+        rel = finite_pose(pos)
+        self._require(SERVO_ON, "move_continuous_rel")
+        limits, label = self._limits(), "move_continuous_rel"
+
+        def retarget(device: Device) -> int | None:
+            last = device.queue[-1] if device.queue else device.current
+            if last is None or last.label != label:
+                return None
+            if last is not device.current:                       # queued: plan it again
+                start = last.motion.at(0.0)
+                last.motion.splice(0.0, straight_to(start, start.compose(rel), limits, False))
+                return last.id
+            if device.stopping:
+                return None
+            t, motion = device.t, last.motion
+            here = motion.at(t)
+            motion.splice(t, transition_to(here, *motion.reference_twist(t), here.compose(rel), limits))
+            return last.id
+        motion_id = self.device.edit(retarget)
+        if motion_id is not None:
+            self._accepted_motion()
+            return {"motion_id": motion_id}
+        return self._submit(lambda start: straight_to(start, start.compose(rel), limits, False), label)
 
     @command
     def move_jog(self, x_vel: float, y_vel: float, theta_vel: float) -> dict:

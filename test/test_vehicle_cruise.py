@@ -89,3 +89,72 @@ def test_cruise_refuses_bad_points(base, point):
 def test_cruise_needs_the_servo(base):
     r = base.move_cruise_abs((100.0, 0.0))
     assert not r.ok and "Unpowered" in r.comment
+
+
+# --- move_continuous_rel -------------------------------------------------------------------
+def run_recording_speed(executor, base, seconds=None):  # noqa: F811
+    speeds = []
+    limit = executor.world.time + (seconds if seconds is not None else 60.0)
+    while (base.device.busy if seconds is None else True) and executor.world.time < limit:
+        executor.step()
+        speeds.append(base.odometry.v)
+    return speeds
+
+
+def reference_now(base):
+    return base.device.current.motion.at(base.device.t)
+
+
+def expected_mm(pose, rel):
+    from acti_motion.base import Pose2D
+    g = pose.compose(Pose2D(rel[0] / 1000.0, rel[1] / 1000.0, math.radians(rel[2])))
+    return 1000.0 * g.x, 1000.0 * g.y, math.degrees(g.theta)
+
+
+def max_accel(speeds, dt):
+    return max(abs(b - a) for a, b in zip(speeds, speeds[1:])) / dt
+
+
+def test_continuous_rel_from_rest(base, executor):  # noqa: F811
+    ready(base)
+    assert base.move_continuous_rel((300.0, 400.0, 45.0)).ok
+    run_recording_speed(executor, base)
+    assert_at(base, 300.0, 400.0, 45.0)
+
+
+@pytest.mark.parametrize("rel, keeps_moving", [((1500.0, 400.0, 30.0), True),
+                                                ((-500.0, 0.0, 0.0), False)])
+def test_continuous_rel_new_target_replaces_the_old_with_continuous_velocity(
+        base, executor, rel, keeps_moving):  # noqa: F811
+    ready(base)
+    first = base.move_continuous_rel((2000.0, 0.0, 0.0)).values["motion_id"]
+    speeds = run_recording_speed(executor, base, 1.5)
+    here = reference_now(base)
+    assert base.move_continuous_rel(rel).values["motion_id"] == first
+    speeds += run_recording_speed(executor, base)
+    assert_at(base, *expected_mm(here, rel))
+    assert max_accel(speeds, executor.dt) < 0.5 * 1.3           # no jump in speed
+    transition = speeds[int(1.5 / executor.dt):int(2.5 / executor.dt)]
+    assert (min(transition) > 0.2) == keeps_moving
+    assert base.device.completed == 1
+
+
+def test_continuous_rel_keeps_only_the_last_target(base, executor):  # noqa: F811
+    ready(base)
+    base.move_continuous_rel((1000.0, 0.0, 0.0))
+    steps(executor, 0.5)
+    for rel in [(800.0, 200.0, 0.0), (600.0, -100.0, 10.0), (700.0, 0.0, -20.0)]:
+        here = reference_now(base)
+        assert base.move_continuous_rel(rel).ok
+        steps(executor, 0.02)
+    run_recording_speed(executor, base)
+    assert_at(base, *expected_mm(here, rel))
+
+
+def test_continuous_rel_queued_behind_a_move_is_retargeted_from_its_start(base, executor):  # noqa: F811
+    ready(base)
+    base.move_linear_abs((500.0, 0.0, 90.0))
+    a = base.move_continuous_rel((100.0, 0.0, 0.0)).values["motion_id"]
+    assert base.move_continuous_rel((300.0, 0.0, 0.0)).values["motion_id"] == a == 2
+    run_recording_speed(executor, base)
+    assert_at(base, 500.0, 300.0, 90.0)

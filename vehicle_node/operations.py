@@ -18,6 +18,7 @@ OPERATIONS: tuple[Operation, ...] = (
     Operation("get_velocity_limit", srv.VehicleGetVelocityLimit),
     Operation("get_version", srv.VehicleGetVersion),
     Operation("move_circular_rel", srv.VehicleMoveCircularRel),
+    Operation("move_continuous_rel", srv.VehicleMoveContinuousRel),
     Operation("move_cruise_abs", srv.VehicleMoveCruiseAbs),
     Operation("move_forward", srv.VehicleMoveForward),
     Operation("move_jog", srv.VehicleMoveJog),
