@@ -309,7 +309,8 @@ class MotionExecutor:
         sim0 = self.world.time
         while self._running.is_set():
             self.step()
+            ahead = 0.0
             if self.real_time_factor > 0:
                 ahead = (self.world.time - sim0) / self.real_time_factor - (time.monotonic() - wall0)
-                if ahead > 0:
-                    time.sleep(ahead)
+            # Sleeping (even 0 s) hands the GIL to service threads once per step.
+            time.sleep(max(ahead, 0.0))
