@@ -77,8 +77,9 @@ def test_every_operation_is_a_service_plus_actions_and_state(ros, arm_node):
     for op in OPERATIONS:
         want = op.srv_type.__module__.split(".")[0] + "/srv/" + op.srv_type.__name__
         assert services.get(ARM + op.name) == [want], op.name
-    topics = dict(ros.node.get_topic_names_and_types())
-    assert topics[ARM + "state"] == ["acti_msgs/msg/ArmState"]
+    # discovery of the topic may trail that of the services
+    assert wait_until(lambda: dict(ros.node.get_topic_names_and_types()).get(ARM + "state")
+                      == ["acti_msgs/msg/ArmState"], 30.0)
 
 
 def test_nested_messages_both_ways(ros, arm_node):
