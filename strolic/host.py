@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import sys
 import time
+from datetime import datetime, timedelta
 
 from .errors import ExceptionKind as K, fail
 
@@ -17,6 +18,8 @@ class Host:
     def __init__(self) -> None:
         self.output: list[bytes] = []
         self.shared: dict[int, int] = {}
+        self.time_offset = timedelta(0)        # STIME/SDATE: set time of day − system time
+        self.clock_origin = self.now()         # CLRCLK: the moment the internal clock read 0
 
     # output stream and console (SYNC, RESULT, TRACE)
     def send(self, data: bytes) -> None:
@@ -25,12 +28,32 @@ class Host:
     def console(self, text: str) -> None:
         print(text, file=sys.stderr)
 
+    def warn(self, text: str) -> None:
+        """A warning on the console (STIME, SDATE, CNFG, DOUT, DIN: the program continues)."""
+        self.console(f"STROLIC warning: {text}")
+
     # clock (cyclic processes, in seconds)
     def now(self) -> float:
         return time.monotonic()
 
     def sleep(self, seconds: float) -> None:
         time.sleep(max(seconds, 0.0))
+
+    # time of day (TIME, DATE, STIME, SDATE) and the internal clock (CLOCK, CLRCLK)
+    def wall_clock(self) -> datetime:
+        """The controller's time of day: the system time plus what STIME/SDATE set."""
+        return datetime.now() + self.time_offset
+
+    def set_wall_clock(self, value: datetime) -> None:
+        """STIME/SDATE: the controller's time of day only; the system clock is not touched."""
+        self.time_offset = value - datetime.now()
+
+    def clock_ms(self) -> int:
+        """The internal clock in milliseconds since the host started or CLRCLK."""
+        return int((self.now() - self.clock_origin) * 1000)
+
+    def clear_clock(self) -> None:
+        self.clock_origin = self.now()
 
     def stop(self, error) -> None:
         """Program execution stopped on an exception (§4.5): robot motion must stop too."""

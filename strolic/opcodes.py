@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from .functions import arithmetic as ar, bits, concurrency as cc, control as ct, data as dt
-from .functions import geometry as ge, strings as st, system as sy
+from .functions import geometry as ge, strings as st, system as sy, system_time as tm
 from .codes import I1, I2, I4, R4, R8
 
 
@@ -175,19 +175,19 @@ VM_FUNCTIONS = [
     op(0xEF8E, "SHARE", "#u number --", cc.share),
 ]
 
-# System (EE) and robot-control (ED) functions (effects from part 3 of the digest). They have no
-# handler yet: the VM hands them to Host.call until the robot binding gives them one.
+# System (EE) functions act through the host's hooks; robot-control (ED) functions have no handler
+# yet: the VM hands them to Host.call until the robot binding gives them one (effects: part 3).
 HOST_FUNCTIONS = [
-    op(0xEE00, "TIME", "-- a:St"),
-    op(0xEE01, "DATE", "-- a:St"),
-    op(0xEE02, "CLOCK", "-- a:I4"),
-    op(0xEE03, "STIME", "a:St --"),
-    op(0xEE04, "SDATE", "a:St --"),
-    op(0xEE05, "CLRCLK", "--"),
-    op(0xEE06, "PACKTM", "h m s -- d:St"),
-    op(0xEE07, "UNPKTM", "a:St -- h m s"),
-    op(0xEE08, "PACKDT", "y mo d -- s:St"),
-    op(0xEE09, "UNPKDT", "a:St -- y mo d"),
+    op(0xEE00, "TIME", "-- a:St", tm.time_),
+    op(0xEE01, "DATE", "-- a:St", tm.date_),
+    op(0xEE02, "CLOCK", "-- a:I4", tm.clock),
+    op(0xEE03, "STIME", "a:St --", tm.stime),
+    op(0xEE04, "SDATE", "a:St --", tm.sdate),
+    op(0xEE05, "CLRCLK", "--", tm.clrclk),
+    op(0xEE06, "PACKTM", "h m s -- d:St", tm.packtm),
+    op(0xEE07, "UNPKTM", "a:St -- h m s", tm.unpktm),
+    op(0xEE08, "PACKDT", "y mo d -- s:St", tm.packdt),
+    op(0xEE09, "UNPKDT", "a:St -- y mo d", tm.unpkdt),
     op(0xEE0A, "CNFG", "port flow speed fmt --"),
     op(0xEE0B, "DOUT", "port data --"),
     op(0xEE0C, "DIN", "port -- data"),

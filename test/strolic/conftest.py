@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import sys
+from datetime import datetime
 from pathlib import Path
 
 import pytest
@@ -24,14 +25,26 @@ VAR #x #y #f #g #h DCL
 
 
 class RecordingHost(Host):
-    """A host that keeps console lines and uses a settable clock."""
+    """A host that keeps console lines; its time of day stands still at 2024/05/06 07:08:09."""
 
     def __init__(self) -> None:
         super().__init__()
         self.lines: list[str] = []
+        self.wall = datetime(2024, 5, 6, 7, 8, 9)
 
     def console(self, text: str) -> None:
         self.lines.append(text)
+
+    def wall_clock(self) -> datetime:
+        return self.wall
+
+    def set_wall_clock(self, value: datetime) -> None:
+        self.wall = value
+
+
+def case_host(directory: Path) -> RecordingHost:
+    """The host of the case table (strolic_cases.py)."""
+    return RecordingHost()
 
 
 def execute(text: str, budget: int | None = 200_000, host: Host | None = None, **vm_options):

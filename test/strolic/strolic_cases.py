@@ -1,10 +1,12 @@
-"""Table of cases for every built-in function EF00–EF8E: normal cases, type promotion, and the
-exceptions the standard lists. Keys are mnemonics; this table is also the coverage table
-(``test_strolic_coverage.py`` checks that no function of the opcode table is missing).
+"""Table of cases for every built-in function EF00–EF8E and system function EE00–EE22: normal
+cases, type promotion, and the exceptions the standard lists. Keys are mnemonics; this table is
+also the coverage table (``test_strolic_coverage.py`` checks that no function is missing).
 
-A case is ``(program, expected)``: the expected final stack in the text form (bottom first), or
-the ExceptionKind that must stop the program. Programs run after ``conftest.PRELUDE``, which
-names and declares x, y, f, g, h.
+A case is ``(program, expected)``: the expected final stack in the text form (bottom first), the
+same inside ``Warns(...)`` when the program must also print a console warning (and otherwise it
+must not), or the ExceptionKind that must stop the program. Programs run after
+``conftest.PRELUDE``, which names and declares x, y, f, g, h, on ``conftest.case_host``: its
+time of day stands at 2024/05/06 07:08:09.
 """
 from __future__ import annotations
 
@@ -14,6 +16,11 @@ OVF, UNF, DIV0 = K.NUMERIC_OVERFLOW, K.NUMERIC_UNDERFLOW, K.DIVISION_BY_ZERO
 TYPE, UNDEF, UNDER = K.TYPE_MISMATCH, K.UNDEFINED_DATA, K.STACK_UNDERFLOW
 AREA, BRANCH, DEAD = K.AREA_ERROR, K.BRANCH_OUT_OF_FUNCTION, K.DEADLOCK
 T, F = "I2:1", "I2:0"          # logical values
+
+
+class Warns(list):
+    """The expected stack of a case that must also print a console warning."""
+
 
 ID = "Trn(0 0 0 1 0 0 0 1 0 0 0 1)"
 T1 = "Trn(10 20 30 1 0 0 0 1 0 0 0 1)"
@@ -309,6 +316,31 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
               "1 CHIN 1 CHIN 1 CHIN", ["1", "2", "3"])],
     "CHOUT": [("1 5 CHOUT 1 6 CHOUT", DEAD), ("1 5 CHOUT 1 CHIN 1 6 CHOUT 1 CHIN", ["5", "6"])],
     "SHARE": [("#x 3 SHARE 1", ["1"]), ("#%2000 1 SHARE", UNDEF), ("5 1 SHARE", TYPE)],
+    # ---- EE: time of day, date, internal clock --------------------------------------------------
+    "TIME": [("TIME", ['"07:08:09"'])],
+    "DATE": [("DATE", ['"2024/05/06"'])],
+    "CLOCK": [("CLOCK 0 GEQ", [T]), ("#x CLOCK STORE #x ASIZE", ["I2:4"])],
+    "STIME": [('"23:59:58" STIME TIME', ['"23:59:58"']), ('"00:00:00" STIME TIME DATE',
+               ['"00:00:00"', '"2024/05/06"']),
+              ('"24:00:00" STIME TIME', Warns(['"07:08:09"'])),
+              ('"7:08:09" STIME TIME', Warns(['"07:08:09"'])),
+              ('"07:08:09:10" STIME TIME', Warns(['"07:08:09"'])), ("1 STIME", TYPE)],
+    "SDATE": [('"2023/12/31" SDATE DATE TIME', ['"2023/12/31"', '"07:08:09"']),
+              ('"2023/02/29" SDATE DATE', Warns(['"2024/05/06"'])),
+              ('"2023-12-31" SDATE DATE', Warns(['"2024/05/06"'])),
+              ('"2101/01/01" SDATE DATE', Warns(['"2024/05/06"'])), ("SDATE", UNDER)],
+    "CLRCLK": [("CLRCLK CLOCK 1000 LT", [T])],
+    "PACKTM": [("7 8 9 PACKTM", ['"07:08:09"']), ("23.4 59 0.5 PACKTM", ['"23:59:01"']),
+               ("23.6 60 -1 PACKTM", ['"00:00:00"']), ("I4:70000 30 30 PACKTM", ['"00:30:30"']),
+               ('"7" 8 9 PACKTM', TYPE), ("8 9 PACKTM", UNDER)],
+    "UNPKTM": [('"07:08:09" UNPKTM', ["I2:7", "I2:8", "I2:9"]),
+               ('"25:08:x" UNPKTM', [F, "I2:8", F]), ('"12:34" UNPKTM', ["I2:12", "I2:34", F]),
+               ('"" UNPKTM', [F, F, F]), ("1 UNPKTM", TYPE)],
+    "PACKDT": [("I2:2024 5 6 PACKDT", ['"2024/05/06"']), ("I2:1800 13 0 PACKDT", ['"1900/01/01"']),
+               ("I2:2024 2 31 PACKDT", ['"2024/02/31"']), ("2000.4 1.5 9 PACKDT", ['"2000/02/09"'])],
+    "UNPKDT": [('"2024/05/06" UNPKDT', ["2024", "I2:5", "I2:6"]),
+               ('"99/5/6" UNPKDT', ["1900", T, T]), ('"2024/13/32" UNPKDT', ["2024", T, T]),
+               ("Vec(1 2 3) UNPKDT", TYPE)],
 }
 
 # Exceptions that Annex 1 Table 1 lists in a function's 例外 cell: each must have a case.
@@ -319,3 +351,6 @@ LISTED_EXCEPTIONS: dict[str, K] = {
     "BRA": BRANCH, "BRF": BRANCH, "BRT": BRANCH, "BAL": BRANCH,
     "RET": K.NO_RETURN_DESTINATION, "NPUSH": UNDEF, "NPOP": UNDEF,
 }
+
+# Functions whose listed exception is a console warning, the program going on (EE area).
+LISTED_WARNINGS = ("STIME", "SDATE")
