@@ -7,19 +7,46 @@ from __future__ import annotations
 
 import sys
 import time
+from dataclasses import dataclass
 from datetime import datetime, timedelta
 
 from .errors import ExceptionKind as K, fail
 
 
+@dataclass(frozen=True)
+class PortSettings:
+    """CNFG: the settings of a communication port."""
+
+    flow_control: bool = False
+    rs_control: bool = False
+    speed: int = 9600                      # bps
+    data_bits: int = 8
+    parity: str = "none"                   # "none", "odd", "even"
+    stop_bits: float = 1
+
+
+class MemoryIO:
+    """Digital I/O in memory: ports 1–8 are 8 bits wide, 9–16 are 16 bits; each port holds one
+    value, written by DOUT and read by DIN (outputs wired back to the inputs of the same
+    number), and a test or simulation may set it directly."""
+
+    def __init__(self, widths: dict[int, int] | None = None) -> None:
+        self.widths = widths if widths is not None else {p: 8 if p <= 8 else 16
+                                                         for p in range(1, 17)}
+        self.values = dict.fromkeys(self.widths, 0)
+
+
 class Host:
-    """A host without robot or OS tasks; it keeps what the VM sends to the programming device."""
+    """A host without robot or OS tasks; it keeps what the VM sends to the programming device,
+    has digital I/O and communication ports in memory."""
 
     def __init__(self) -> None:
         self.output: list[bytes] = []
         self.shared: dict[int, int] = {}
         self.time_offset = timedelta(0)        # STIME/SDATE: set time of day − system time
         self.clock_origin = self.now()         # CLRCLK: the moment the internal clock read 0
+        self.io = MemoryIO()
+        self.port_settings = {1: PortSettings(), 2: PortSettings()}   # communication ports
 
     # output stream and console (SYNC, RESULT, TRACE)
     def send(self, data: bytes) -> None:
@@ -57,6 +84,25 @@ class Host:
 
     def stop(self, error) -> None:
         """Program execution stopped on an exception (§4.5): robot motion must stop too."""
+
+    # digital I/O ports (DOUT, DIN, IOWAIT); values are unsigned, within the port's width
+    def io_port_bits(self, port: int, output: bool) -> int | None:
+        """The width of an output (``output``) or input port in bits, None if there is none."""
+        return self.io.widths.get(port)
+
+    def write_io(self, port: int, value: int) -> None:
+        self.io.values[port] = value
+
+    def read_io(self, port: int) -> int:
+        return self.io.values[port]
+
+    # communication ports (CNFG)
+    def configure_port(self, port: int, settings: PortSettings) -> bool:
+        """CNFG: False when there is no such port."""
+        if port not in self.port_settings:
+            return False
+        self.port_settings[port] = settings
+        return True
 
     # robot and system functions without a handler in the opcode table
     def call(self, vm, proc, opcode) -> object:

@@ -12,6 +12,7 @@ from typing import Callable
 
 from .functions import arithmetic as ar, bits, concurrency as cc, control as ct, data as dt
 from .functions import geometry as ge, strings as st, system as sy, system_time as tm
+from .functions import system_io as io
 from .codes import I1, I2, I4, R4, R8
 
 
@@ -188,10 +189,10 @@ HOST_FUNCTIONS = [
     op(0xEE07, "UNPKTM", "a:St -- h m s", tm.unpktm),
     op(0xEE08, "PACKDT", "y mo d -- s:St", tm.packdt),
     op(0xEE09, "UNPKDT", "a:St -- y mo d", tm.unpkdt),
-    op(0xEE0A, "CNFG", "port flow speed fmt --"),
-    op(0xEE0B, "DOUT", "port data --"),
-    op(0xEE0C, "DIN", "port -- data"),
-    op(0xEE0D, "IOWAIT", "port mask cond timeout -- masked tflag"),
+    op(0xEE0A, "CNFG", "port flow speed fmt --", io.cnfg),
+    op(0xEE0B, "DOUT", "port data --", io.dout),
+    op(0xEE0C, "DIN", "port -- data", io.din),
+    op(0xEE0D, "IOWAIT", "port mask cond timeout -- masked tflag", io.iowait),
     op(0xEE0E, "ACT", "level --"),
     op(0xEE0F, "ACTRS", "level --"),
     op(0xEE10, "REACT", "--"),

@@ -69,6 +69,8 @@ class Process:
         self.blocked_at = RETRY            # VM generation when it last had to wait
         self.last_run = 0
         self.event_buffer: list[int] = []
+        self.wake_at: float | None = None  # a waiting process looks again at this host time
+        self.timed: tuple | None = None    # ((frame, pc), end) of the timed wait it is in
         self.push = self.stack.append
 
     def pop(self):

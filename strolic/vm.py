@@ -52,6 +52,21 @@ class VM:
     def changed(self) -> None:
         self.generation += 1
 
+    def timed_wait(self, proc: Process, seconds: float, poll: float | None = None):
+        """For a blocking function that gives up after ``seconds`` (∞: never): ``None`` once that
+        time has passed since its first attempt, else ``WAIT``, the process looking again when
+        something changes, after ``poll`` seconds (a condition outside the VM) or at the end."""
+        key = (proc.frame, proc.frame.pc)
+        now = self.host.now()
+        if proc.timed is None or proc.timed[0] != key:
+            proc.timed = (key, now + seconds)
+        end = proc.timed[1]
+        if now >= end:
+            proc.timed = None
+            return None
+        proc.wake_at = min(end, now + poll) if poll is not None else end
+        return WAIT
+
     def scopes_for_new_process(self) -> list[Scope]:
         return [self.globals]
 
@@ -110,28 +125,42 @@ class VM:
         if proc.state is State.WAITING:
             if proc.period and proc.blocked_at == CYCLE_WAIT:
                 return now is not None and now >= proc.next_start
+            if proc.wake_at is not None and now is not None and now >= proc.wake_at:
+                return True
             return proc.blocked_at != self.generation
         return False
 
     def _pick(self) -> Process | None:
-        cyclic = any(p.period for p in self.processes.values())
-        now = self.host.now() if cyclic else None
+        timed = any(p.period or p.wake_at is not None for p in self.processes.values())
+        now = self.host.now() if timed else None
         best = None
         for proc in self.processes.values():
             if self._eligible(proc, now) and (best is None or (proc.priority, proc.last_run)
                                               < (best.priority, best.last_run)):
                 best = proc
         if best is not None and best.state is State.WAITING:
+            best.wake_at = None
             if best.blocked_at == CYCLE_WAIT:
                 best.restart()
             else:
                 best.state = State.RUNNING
         return best
 
+    def _due_times(self) -> list[float]:
+        """Host times at which a waiting process may proceed (cyclic starts, timed waits)."""
+        due = []
+        for proc in self.processes.values():
+            if proc.state is State.WAITING:
+                if proc.blocked_at == CYCLE_WAIT:
+                    due.append(proc.next_start)
+                elif proc.wake_at is not None:
+                    due.append(proc.wake_at)
+        return due
+
     def _idle(self) -> None:
-        """Nothing can run: sleep until a cyclic start is due, or report the deadlock."""
-        due = [p.next_start for p in self.processes.values()
-               if p.state is State.WAITING and p.blocked_at == CYCLE_WAIT]
+        """Nothing can run: sleep until a cyclic start or timed wait is due, or report the
+        deadlock."""
+        due = self._due_times()
         if not due:
             frame = self.main.frame
             code = frame.codes[frame.pc] if frame.pc < len(frame.codes) else None

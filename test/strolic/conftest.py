@@ -42,6 +42,18 @@ class RecordingHost(Host):
         self.wall = value
 
 
+class ClockHost(RecordingHost):
+    """A recording host whose clock moves only when the VM sleeps (exact timings)."""
+
+    time = 0.0
+
+    def now(self) -> float:
+        return self.time
+
+    def sleep(self, seconds: float) -> None:
+        self.time += max(seconds, 0.0)
+
+
 def case_host(directory: Path) -> RecordingHost:
     """The host of the case table (strolic_cases.py)."""
     return RecordingHost()

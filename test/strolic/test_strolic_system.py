@@ -3,8 +3,10 @@ from __future__ import annotations
 
 from datetime import datetime, timedelta
 
-from conftest import RecordingHost, execute, stack_of
-from strolic.host import Host
+import pytest
+
+from conftest import ClockHost, RecordingHost, execute, stack_of
+from strolic.host import Host, PortSettings
 
 
 class ConsoleHost(RecordingHost):
@@ -54,3 +56,63 @@ def test_internal_clock_counts_milliseconds_from_clrclk() -> None:
     assert [item.value for item in main.stack] == [2500, 0]
     host.time += 2**31 / 1000 + 1.0               # the I4 clock wraps to 0 after 2³¹ − 1 ms
     assert vm.run(b"\xee\x02").stack[0].value in (999, 1000)
+
+
+# ---- communication ports and digital I/O --------------------------------------------------------
+def test_cnfg_records_the_port_settings_in_the_host() -> None:
+    host = RecordingHost()
+    execute("1 3 6 0x2F CNFG 2 0 1 0x0A CNFG 2 0 9 1 CNFG", host=host)
+    assert host.port_settings[1] == PortSettings(flow_control=True, rs_control=True,
+                                                 speed=19200, data_bits=8, parity="even",
+                                                 stop_bits=2)
+    assert host.port_settings[2] == PortSettings(speed=300, data_bits=7, parity="odd",
+                                                 stop_bits=1.5)
+    assert host.lines == ["STROLIC warning: CNFG: invalid setting for port 2 (b=0, c=9, d=1); "
+                          "nothing is set"]
+
+
+def test_iowait_times_out_after_its_milliseconds() -> None:
+    host = ClockHost()
+    _, main = execute("1 1 1 250 IOWAIT", host=host)
+    assert [item.value for item in main.stack] == [0, 1]
+    assert host.time == pytest.approx(0.25)
+
+
+def test_iowait_sees_an_input_set_outside_the_vm() -> None:
+    class Sensor(ClockHost):
+        def read_io(self, port: int) -> int:
+            return 0b100 if self.time >= 0.1 else 0
+
+    host = Sensor()
+    _, main = execute("3 4 1 1000 IOWAIT", host=host)
+    assert [item.value for item in main.stack] == [4, 0]
+    assert 0.1 <= host.time < 0.11
+
+
+def test_each_iowait_gets_its_own_timeout() -> None:
+    host = ClockHost()
+    program = "#f Fn{ >body BAL >body BAL RET body: 1 1 1 100 IOWAIT RET END } STORE f"
+    _, main = execute(program, host=host)
+    assert [item.value for item in main.stack] == [0, 1, 0, 1]
+    assert host.time == pytest.approx(0.2)
+
+
+def test_a_host_with_its_own_ports() -> None:
+    class Robot(RecordingHost):
+        def __init__(self) -> None:
+            super().__init__()
+            self.written: list[tuple[int, int]] = []
+
+        def io_port_bits(self, port: int, output: bool) -> int | None:
+            return 8 if (port == 1) == output else None      # 1 is an output, 2 an input
+
+        def write_io(self, port: int, value: int) -> None:
+            self.written.append((port, value))
+
+        def read_io(self, port: int) -> int:
+            return 0x5A
+
+    host = Robot()
+    assert stack_of("1 I2:0x1A5 DOUT 2 DIN 1 DIN", host=host) == ["I2:90", "I2:0"]
+    assert host.written == [(1, 0xA5)]
+    assert host.lines == ["STROLIC warning: DIN: input port 1 does not exist"]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
-from conftest import PRELUDE, RecordingHost, error_of, execute, stack_of
+from conftest import PRELUDE, ClockHost, RecordingHost, error_of, execute, stack_of
 from strolic.codec import encode
 from strolic.codes import Num, I2
 from strolic.errors import ExceptionKind as K, StrolicError
@@ -187,16 +187,7 @@ def test_equal_function_bodies_at_different_offsets_branch_correctly() -> None:
 
 
 def test_cyclic_process_runs_every_period_on_the_host_clock() -> None:
-    class Clock(RecordingHost):
-        time = 0.0
-
-        def now(self):
-            return self.time
-
-        def sleep(self, seconds):
-            self.time += seconds
-
-    host = Clock()
+    host = ClockHost()
     program = ("#x 0 STORE #f Fn{ #x x INC STORE x RESULT x 3 GEQ >s BRT END s: 2 ESIG END } "
                "STORE #f 1 FXQT DROP 1 100 FCYCLE DROP 2 EWAIT 1 0 FCYCLE x")
     _, main = execute(program, host=host)
