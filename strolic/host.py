@@ -5,10 +5,13 @@ row without a handler is dispatched to ``Host.call``.
 """
 from __future__ import annotations
 
+import io
 import sys
 import time
 from dataclasses import dataclass
 from datetime import datetime, timedelta
+from pathlib import Path, PurePath
+from typing import BinaryIO
 
 from .errors import ExceptionKind as K, fail
 
@@ -36,9 +39,50 @@ class MemoryIO:
         self.values = dict.fromkeys(self.widths, 0)
 
 
+class Loopback(io.RawIOBase):
+    """A communication port with a loopback plug: what is written can be read back."""
+
+    def __init__(self, buffer: bytearray) -> None:
+        super().__init__()
+        self.buffer = buffer
+
+    def readable(self) -> bool:
+        return True
+
+    def writable(self) -> bool:
+        return True
+
+    def readinto(self, target) -> int:
+        count = min(len(target), len(self.buffer))
+        target[:count] = self.buffer[:count]
+        del self.buffer[:count]
+        return count
+
+    def write(self, data) -> int:
+        self.buffer.extend(data)
+        return len(data)
+
+
+def inside(root: Path | None, name: str) -> Path:
+    """The path of file ``name`` in the directory ``root``; a name that could leave it (absolute,
+    with a ``..`` part) or that leads out of it through a symbolic link is refused, and nothing
+    is opened."""
+    if root is None:
+        raise fail(K.FILE_ERROR, "this host has no program directory for files")
+    relative = PurePath(name)
+    if not name or "\0" in name or relative.is_absolute() or relative.drive \
+            or ".." in relative.parts:
+        raise fail(K.FILE_OUTSIDE, f"{name!r} is not a name inside the program directory")
+    base = Path(root).resolve()
+    target = (base / relative).resolve()
+    if target != base and base not in target.parents:
+        raise fail(K.FILE_OUTSIDE, f"{name!r} leads out of the program directory")
+    return target
+
+
 class Host:
     """A host without robot or OS tasks; it keeps what the VM sends to the programming device,
-    has digital I/O and communication ports in memory."""
+    has digital I/O and communication ports in memory, and files in a program directory."""
 
     def __init__(self) -> None:
         self.output: list[bytes] = []
@@ -47,6 +91,10 @@ class Host:
         self.clock_origin = self.now()         # CLRCLK: the moment the internal clock read 0
         self.io = MemoryIO()
         self.port_settings = {1: PortSettings(), 2: PortSettings()}   # communication ports
+        self.port_files = {101: 1, 102: 2}     # file number → communication port
+        self.port_buffers = {port: bytearray() for port in self.port_settings}
+        self.file_root: Path | None = None     # the program directory (None: no files)
+        self.files: dict[int, str] = {}        # file number → name in the program directory
 
     # output stream and console (SYNC, RESULT, TRACE)
     def send(self, data: bytes) -> None:
@@ -103,6 +151,18 @@ class Host:
             return False
         self.port_settings[port] = settings
         return True
+
+    # files (FOPEN … GETC)
+    def file_name(self, number: int) -> str:
+        """The name of file ``number`` in the program directory."""
+        return self.files.get(number, f"file{number}.txt")
+
+    def open_file(self, number: int, mode: str) -> BinaryIO:
+        """FOPEN: a binary stream for file ``number``, mode 'r', 'w' (truncate) or 'a'; the
+        files of communication ports are loopbacks; OSError or StrolicError when it fails."""
+        if number in self.port_files:
+            return Loopback(self.port_buffers[self.port_files[number]])
+        return open(inside(self.file_root, self.file_name(number)), mode + "b")
 
     # robot and system functions without a handler in the opcode table
     def call(self, vm, proc, opcode) -> object:

@@ -12,7 +12,7 @@ from typing import Callable
 
 from .functions import arithmetic as ar, bits, concurrency as cc, control as ct, data as dt
 from .functions import geometry as ge, strings as st, system as sy, system_time as tm
-from .functions import system_io as io
+from .functions import system_files as fl, system_format as fm, system_io as io
 from .codes import I1, I2, I4, R4, R8
 
 
@@ -201,16 +201,16 @@ HOST_FUNCTIONS = [
     op(0xEE13, "TIMER", "timeout --"),
     op(0xEE14, "RTIMER", "--"),
     op(0xEE15, "TACTION", "handler --"),
-    op(0xEE16, "FSTAT", "file -- status:I2"),
-    op(0xEE17, "OUTPUT", "file data --"),
-    op(0xEE18, "INPUT", "file -- data"),
-    op(0xEE19, "LOUTPUT", "file data --"),
-    op(0xEE1A, "LINPUT", "file #t -- data:t"),
-    op(0xEE1B, "FOPEN", "file mode --"),
-    op(0xEE1C, "FCLOSE", "file --"),
-    op(0xEE1D, "PUTC", "file ch --"),
-    op(0xEE1E, "GETC", "file -- ch:I2"),
-    op(0xEE1F, "DECODE1", "str #t -- value"),
+    op(0xEE16, "FSTAT", "file -- status:I2", fl.fstat),
+    op(0xEE17, "OUTPUT", "file data --", fl.output),
+    op(0xEE18, "INPUT", "file -- data", fl.input_),
+    op(0xEE19, "LOUTPUT", "file data --", fl.loutput),
+    op(0xEE1A, "LINPUT", "file #t -- data:t", fl.linput),
+    op(0xEE1B, "FOPEN", "file mode --", fl.fopen),
+    op(0xEE1C, "FCLOSE", "file --", fl.fclose),
+    op(0xEE1D, "PUTC", "file ch --", fl.putc),
+    op(0xEE1E, "GETC", "file -- ch:I2", fl.getc),
+    op(0xEE1F, "DECODE1", "str #t -- value", fm.decode1),
     op(0xEE20, "ENCODE1", "fmt b1 … bn n -- str"),
     op(0xEE21, "DECODE2", "fmt str #c1 … #cn n -- count:I2"),
     op(0xEE22, "ENCODE2", "fmt b1 … bn n -- str"),

@@ -35,6 +35,7 @@ class VM:
         self.executed = 0                  # instructions of the current run (budget)
         self.budget: int | None = None
         self.main: Process | None = None   # process 0, the program of the current run
+        self.files: dict = {}              # file number → open file (functions/system_files.py)
         self.reset()
 
     # ---- state ----------------------------------------------------------------------------------
@@ -48,6 +49,16 @@ class VM:
         self.flags: set[int] = set()       # event flags that are on
         self.channels: dict[int, object] = {}
         self.processes: dict[int, Process] = {}
+        self.close_files()
+
+    def close_files(self) -> None:
+        """At INIT and at the end of every run: the files the program left open are closed."""
+        files, self.files = self.files, {}
+        for file in files.values():
+            try:
+                file.close()
+            except StrolicError:
+                pass                       # the run is over: nothing left to stop
 
     def changed(self) -> None:
         self.generation += 1
@@ -117,6 +128,8 @@ class VM:
         except StrolicError as error:
             self.host.stop(error)
             raise
+        finally:
+            self.close_files()
         return main
 
     def _eligible(self, proc: Process, now: float | None) -> bool:

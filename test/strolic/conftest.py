@@ -55,8 +55,18 @@ class ClockHost(RecordingHost):
 
 
 def case_host(directory: Path) -> RecordingHost:
-    """The host of the case table (strolic_cases.py)."""
-    return RecordingHost()
+    """The host of the case table (strolic_cases.py). Its program directory is
+    ``directory/program`` (file N is ``fileN.txt``), with a subdirectory ``sub``; a symbolic link
+    ``out`` leads to ``directory/outside``. File 7 is named ``../outside.txt``, 8 an absolute
+    path, 9 ``out/x.txt`` (through the link), 10 ``sub/data.txt``, 11 ``sub`` (a directory)."""
+    host = RecordingHost()
+    host.file_root = directory / "program"
+    (host.file_root / "sub").mkdir(parents=True)
+    (directory / "outside").mkdir()
+    (host.file_root / "out").symlink_to(directory / "outside", target_is_directory=True)
+    host.files.update({7: "../outside.txt", 8: str(directory / "outside" / "abs.txt"),
+                       9: "out/x.txt", 10: "sub/data.txt", 11: "sub"})
+    return host
 
 
 def execute(text: str, budget: int | None = 200_000, host: Host | None = None, **vm_options):

@@ -15,7 +15,9 @@ from strolic.errors import ExceptionKind as K
 OVF, UNF, DIV0 = K.NUMERIC_OVERFLOW, K.NUMERIC_UNDERFLOW, K.DIVISION_BY_ZERO
 TYPE, UNDEF, UNDER = K.TYPE_MISMATCH, K.UNDEFINED_DATA, K.STACK_UNDERFLOW
 AREA, BRANCH, DEAD = K.AREA_ERROR, K.BRANCH_OUT_OF_FUNCTION, K.DEADLOCK
+FILE, OUTSIDE, CONVERSION = K.FILE_ERROR, K.FILE_OUTSIDE, K.CONVERSION_ERROR
 T, F = "I2:1", "I2:0"          # logical values
+READ1 = "1 FCLOSE 1 1 FOPEN"   # after writing file 1: read it from the start
 
 
 class Warns(list):
@@ -26,6 +28,7 @@ ID = "Trn(0 0 0 1 0 0 0 1 0 0 0 1)"
 T1 = "Trn(10 20 30 1 0 0 0 1 0 0 0 1)"
 RZ90 = "Trn(0 0 0 0 1 0 -1 0 0 0 0 1)"          # rotation of 90° about z
 FMT_T1 = "Trn(10.0 20.0 30.0 1.0 0.0 0.0 0.0 1.0 0.0 0.0 0.0 1.0)"
+FMT_ID = "Trn(0.0 0.0 0.0 1.0 0.0 0.0 0.0 1.0 0.0 0.0 0.0 1.0)"
 POSE_ZERO = " ".join(["0.0"] * 12) + " I2:0 0.0"  # the 14 pose elements
 FN_WAIT = "#f Fn{ 1 EWAIT END } STORE"            # a process that waits for flag 1
 
@@ -360,6 +363,57 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
                ("#f Fn{ 1 8 DOUT END } STORE #f 1 FXQT DROP 1 12 2 1000 IOWAIT", ["I2:8", F]),
                ("99 1 1 0 IOWAIT", Warns([F, T])), ("1 1 3 0 IOWAIT", UNDEF),
                ("1 1.0 1 0 IOWAIT", TYPE), ("1 1 1 \"a\" IOWAIT", TYPE), ("1 1 0 IOWAIT", UNDER)],
+    # ---- EE: files (see conftest.case_host: files 7, 8, 9 lie outside the program directory;
+    # files 101, 102 are communication ports 1, 2 with a loopback plug) ------------------------
+    "FOPEN": [("1 2 FOPEN 1 5 OUTPUT 1 FCLOSE 1 1 FOPEN 1 INPUT", ["5"]),
+              (f"1 2 FOPEN 1 5 OUTPUT 1 FCLOSE 1 4 FOPEN 1 6 OUTPUT {READ1} 1 INPUT 1 INPUT",
+               ["5", "6"]),
+              (f"1 2 FOPEN 1 5 OUTPUT 1 FCLOSE 1 2 FOPEN {READ1} 1 FSTAT", [T]),
+              ("10 2 FOPEN 10 FSTAT", [F]), ("1.4 2 FOPEN 1 FSTAT", [F]),
+              ("1 1 FOPEN", FILE), ("1 3 FOPEN", FILE), ("1 2 FOPEN 1 2 FOPEN", FILE),
+              ("0 2 FOPEN", FILE), ("11 1 FOPEN", FILE), ("7 2 FOPEN", OUTSIDE),
+              ("8 2 FOPEN", OUTSIDE), ("9 2 FOPEN", OUTSIDE), ('"a" 2 FOPEN', TYPE)],
+    "FCLOSE": [("1 2 FOPEN 1 FCLOSE 1 FSTAT", ["I2:2"]), ("1 FCLOSE", FILE)],
+    "FSTAT": [("1 FSTAT", ["I2:2"]), (f"1 2 FOPEN {READ1} 1 FSTAT", [T]),
+              (f"1 2 FOPEN 1 7 PUTC {READ1} 1 FSTAT 1 GETC 1 FSTAT", [F, "I2:7", T]),
+              ("1 2 FOPEN 1 FSTAT", [F]), ("FSTAT", UNDER)],
+    "OUTPUT": [(f'1 2 FOPEN 1 5 OUTPUT 1 2.5 OUTPUT 1 "ab" OUTPUT 1 Vec(1 2 3) OUTPUT '
+                f"{READ1} 1 INPUT 1 INPUT 1 INPUT 1 INPUT", ["5", "2.5", '"ab"', "Vec(1.0 2.0 3.0)"]),
+               ("1 5 OUTPUT", FILE), ("1 2 FOPEN 1 #x OUTPUT", TYPE),
+               (f"1 2 FOPEN {READ1} 1 5 OUTPUT", FILE)],
+    "INPUT": [(f'1 2 FOPEN 1 I2:300 OUTPUT 1 -1e3 OUTPUT 1 "a b" LOUTPUT 1 Ar[I2 1 2] OUTPUT '
+               f"{READ1} 1 INPUT 1 INPUT 1 INPUT 1 INPUT 1 INPUT",
+               ["300", "-1000.0", '"a"', '"b"', "Ar[I2 1 2]"]),
+              (f'1 2 FOPEN 1 "x<y" OUTPUT 1 "\\"q\\"" OUTPUT {READ1} 1 INPUT 1 INPUT',
+               ['"x<y"', '"q"']),
+              (f"1 2 FOPEN {READ1} 1 INPUT", FILE), ("1 INPUT", FILE),
+              ("1 2 FOPEN 1 INPUT", FILE)],
+    "LOUTPUT": [(f'1 2 FOPEN 1 "x y" LOUTPUT 1 3 LOUTPUT {READ1} 1 #St(0) LINPUT '
+                 "1 #I2 LINPUT", ['"x y"', "I2:3"]), ("1 1 LOUTPUT", FILE)],
+    "LINPUT": [(f'1 2 FOPEN 1 "1, 2, 3" LOUTPUT {READ1} 1 #Vec LINPUT',
+                ["Vec(1.0 2.0 3.0)"]),
+               (f"1 2 FOPEN 1 55 PUTC 1 13 PUTC 1 10 PUTC {READ1} 1 #St(0) LINPUT",
+                ['"7"']),
+               (f"1 2 FOPEN 1 55 PUTC {READ1} 1 #I4 LINPUT", ["I4:7"]),
+               (f'1 2 FOPEN 1 "abc" LOUTPUT {READ1} 1 #I2 LINPUT', CONVERSION),
+               (f"1 2 FOPEN {READ1} 1 #St(0) LINPUT", FILE), ("1 #I2 LINPUT", FILE),
+               ("1 2 LINPUT", TYPE)],
+    "PUTC": [(f"1 2 FOPEN 1 I2:321 PUTC {READ1} 1 GETC", ["I2:65"]),
+             ("1 65 PUTC", FILE), ("1 65.0 PUTC", TYPE)],
+    "GETC": [("101 2 FOPEN 101 72 PUTC 101 FCLOSE 101 1 FOPEN 101 GETC 101 FSTAT", ["I2:72", T]),
+             (f"1 2 FOPEN {READ1} 1 GETC", FILE), ("1 GETC", FILE)],
+    # ---- EE: format conversion (Annex 2) -------------------------------------------------------
+    "DECODE1": [('" 42 " #I2 DECODE1', ["I2:42"]), ('"2.6" #I1 DECODE1', ["3"]),
+                ('"1e3" #R4 DECODE1', ["R4:1000.0"]), ('"-.5" #R8 DECODE1', ["-0.5"]),
+                ('"a b" #St(0) DECODE1', ['"a b"']), ('"ab" #Rd(0) DECODE1', ["Rd<6162>"]),
+                ('"1,2 3" #Vec DECODE1', ["Vec(1.0 2.0 3.0)"]),
+                ('"Vec(1 2 3)" #Vec DECODE1', ["Vec(1.0 2.0 3.0)"]),
+                ('"1 2 3" #Ar(0, I4) DECODE1', ["Ar[I4 1 2 3]"]),
+                ('"0 0 0 1 0 0 0 1 0 0 0 1 1 0" #Pm(0) DECODE1 TRN', [FMT_ID]),
+                ('"12x" #I2 DECODE1', CONVERSION), ('"300" #I1 DECODE1', CONVERSION),
+                ('"1 2" #Vec DECODE1', CONVERSION), ('"1" #Fn(0) DECODE1', CONVERSION),
+                ('"Vec(1 2 3)" #Trn DECODE1', CONVERSION),
+                ("5 #I2 DECODE1", TYPE), ('"5" 5 DECODE1', TYPE)],
 }
 
 # Exceptions that Annex 1 Table 1 lists in a function's 例外 cell: each must have a case.
@@ -369,6 +423,9 @@ LISTED_EXCEPTIONS: dict[str, K] = {
     "PUSH": UNDEF, "EXTB": AREA, "EMBB": AREA, "EXTE": AREA, "EMBE": AREA,
     "BRA": BRANCH, "BRF": BRANCH, "BRT": BRANCH, "BAL": BRANCH,
     "RET": K.NO_RETURN_DESTINATION, "NPUSH": UNDEF, "NPOP": UNDEF,
+    # EE area: "program stops" on a failing file access or conversion
+    "FOPEN": FILE, "FCLOSE": FILE, "OUTPUT": FILE, "INPUT": FILE, "LOUTPUT": FILE,
+    "LINPUT": FILE, "PUTC": FILE, "GETC": FILE, "DECODE1": CONVERSION,
 }
 
 # Functions whose listed exception is a console warning, the program going on (EE area).

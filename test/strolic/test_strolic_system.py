@@ -2,10 +2,12 @@
 from __future__ import annotations
 
 from datetime import datetime, timedelta
+from pathlib import Path
 
 import pytest
 
-from conftest import ClockHost, RecordingHost, execute, stack_of
+from conftest import ClockHost, RecordingHost, error_of, execute, stack_of
+from strolic.errors import ExceptionKind
 from strolic.host import Host, PortSettings
 
 
@@ -116,3 +118,64 @@ def test_a_host_with_its_own_ports() -> None:
     assert stack_of("1 I2:0x1A5 DOUT 2 DIN 1 DIN", host=host) == ["I2:90", "I2:0"]
     assert host.written == [(1, 0xA5)]
     assert host.lines == ["STROLIC warning: DIN: input port 1 does not exist"]
+
+
+# ---- files: inside the program directory only ---------------------------------------------------
+def file_host(root: Path, **files: str) -> RecordingHost:
+    host = RecordingHost()
+    host.file_root = root
+    host.files.update({int(number[1:]): name for number, name in files.items()})
+    return host
+
+
+def test_files_are_written_and_read_in_the_program_directory(tmp_path: Path) -> None:
+    (tmp_path / "points.txt").write_bytes(b"10 -2.5 Vec(1.0 2.0 3.0)\n# a note\n")
+    host = file_host(tmp_path, n3="points.txt", n4="log/run.txt")
+    (tmp_path / "log").mkdir()
+    program = ('3 1 FOPEN 3 INPUT 3 INPUT 3 INPUT 3 #St(0) LINPUT 3 #St(0) LINPUT 3 FSTAT '
+               '4 2 FOPEN 4 "x" OUTPUT 4 I2:7 OUTPUT 4 R4:0.5 LOUTPUT 4 65 PUTC')
+    assert stack_of(program, host=host) == ["10", "-2.5", "Vec(1.0 2.0 3.0)", '""', '"# a note"',
+                                            "I2:1"]
+    assert (tmp_path / "log" / "run.txt").read_bytes() == b"x 7 0.5\nA"   # closed at the end
+    assert (tmp_path / "file1.txt").exists() is False
+
+
+def test_a_symbolic_link_inside_the_directory_may_be_used(tmp_path: Path) -> None:
+    (tmp_path / "data").mkdir()
+    (tmp_path / "data" / "real.txt").write_bytes(b"42\n")
+    (tmp_path / "alias.txt").symlink_to(tmp_path / "data" / "real.txt")
+    assert stack_of("1 1 FOPEN 1 INPUT", host=file_host(tmp_path, n1="alias.txt")) == ["42"]
+
+
+@pytest.mark.parametrize("name", ["../escape.txt", "sub/../../escape.txt", "/tmp/escape.txt",
+                                  "link/escape.txt", "secret.txt", "", "a\0b"])
+@pytest.mark.parametrize("mode", [1, 2, 4])
+def test_a_path_out_of_the_program_directory_is_refused_and_never_opened(
+        tmp_path: Path, name: str, mode: int) -> None:
+    root, outside = tmp_path / "program", tmp_path / "outside"
+    (root / "sub").mkdir(parents=True)
+    outside.mkdir()
+    (root / "link").symlink_to(outside, target_is_directory=True)
+    (outside / "secret.txt").write_bytes(b"secret")
+    (root / "secret.txt").symlink_to(outside / "secret.txt")
+    if name.startswith("/tmp/"):
+        name = str(outside / "escape.txt")
+    error = error_of(f"1 {mode} FOPEN 1 INPUT", host=file_host(root, n1=name))
+    assert (error.kind, error.function) == (ExceptionKind.FILE_OUTSIDE, "FOPEN")
+    assert sorted(p.name for p in outside.iterdir()) == ["secret.txt"]
+    assert (outside / "secret.txt").read_bytes() == b"secret"
+    assert not (tmp_path / "escape.txt").exists()
+
+
+def test_a_host_without_a_program_directory_has_no_files() -> None:
+    error = error_of("1 2 FOPEN", host=RecordingHost())
+    assert error.kind is ExceptionKind.FILE_ERROR
+    assert error.detail == "this host has no program directory for files"
+
+
+def test_files_are_closed_when_the_program_stops_and_at_init(tmp_path: Path) -> None:
+    host = file_host(tmp_path)
+    error_of('1 2 FOPEN 1 "kept" OUTPUT 1 0 DIV', host=host)
+    assert (tmp_path / "file1.txt").read_bytes() == b"kept "
+    assert stack_of('2 2 FOPEN 2 "a" OUTPUT INIT 2 FSTAT', host=host) == ["I2:2"]
+    assert (tmp_path / "file2.txt").read_bytes() == b"a "
