@@ -9,13 +9,15 @@ import re
 from typing import TYPE_CHECKING
 
 from ..codes import (ARRAY, I2, NUMERIC_TAGS, POSE, R4, R8, RECORD, STRING, TAG_NAMES, TRANSFORM,
-                     VECTOR, Array, Num, Pose, Record, Str, TagHead, Trn, Vec, make_number,
-                     round_half_away)
-from ..errors import ExceptionKind as K, StrolicError, fail
+                     VECTOR, Array, Num, Pose, Record, Str, TagHead, Trn, UserCode, Vec,
+                     make_number, round_half_away, type_name, user_key)
+from ..errors import StrolicError
+from ..formatting import assignments, basic_encode, c_decode, c_encode, conversion_error
 from ..literals import format_head
 from ..process import Process
-from ..values import data_of, head_of
-from .args import pop_head, pop_of
+from ..values import array_elements, data_of, head_of
+from ..variables import find
+from .args import expect, pop_count, pop_head, pop_many, pop_of
 
 if TYPE_CHECKING:
     from ..vm import VM
@@ -24,10 +26,6 @@ NUMBER = re.compile(rb"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 INTEGER = re.compile(rb"[+-]?\d+")
 SEPARATORS = re.compile(rb"[\s,]+")
 COUNTS = {VECTOR: 3, TRANSFORM: 12, POSE: 14}
-
-
-def conversion_error(detail: str) -> StrolicError:
-    return fail(K.CONVERSION_ERROR, detail)
 
 
 # ---- text → data (DECODE1, LINPUT, INPUT) -------------------------------------------------------
@@ -100,3 +98,54 @@ def decode1(vm: VM, proc: Process) -> None:
     """DECODE1 a #b: string a converted to the type of tag b."""
     head = pop_head(proc)
     proc.push(decode_text(pop_of(proc, Str, "a string").data, head))
+
+
+# ---- data → text (ENCODE1, ENCODE2), text → variables (DECODE2) ----------------------------------
+def scalars(items: list) -> list:
+    """The data as numbers and strings: Vec, Trn, Pm and arrays give their elements in order."""
+    out = []
+    for item in items:
+        if isinstance(item, (Num, Str)):
+            out.append(item)
+        elif isinstance(item, (Vec, Trn)):
+            out.extend(Num(R4, v) for v in (item.xyz if isinstance(item, Vec) else item.values))
+        elif isinstance(item, Pose):
+            out.extend(item.elements)
+        elif isinstance(item, Array):
+            out.extend(scalars(array_elements(item)))
+        else:
+            raise conversion_error(f"{type_name(item)} cannot be converted to text")
+    return out
+
+
+def _pop_data(proc: Process) -> tuple[bytes, list]:
+    """a b1 … bn n: the format string and the data (numbers and strings)."""
+    items = pop_many(proc, pop_count(proc))
+    template = pop_of(proc, Str, "a format string").data
+    return template, scalars(items)
+
+
+def encoder(convert):
+    """ENCODE1 (BASIC image), ENCODE2 (C format): a b1 … bn n → the string."""
+    def handler(vm: VM, proc: Process) -> None:
+        proc.push(Str(convert(*_pop_data(proc))))
+    return handler
+
+
+encode1, encode2 = encoder(basic_encode), encoder(c_encode)
+
+
+def decode2(vm: VM, proc: Process) -> None:
+    """DECODE2 a b #c1 … #cn n: sscanf of string b with format a; the values go to c1, c2 …
+    (as STORE), the count of values (−1: b ended before the first conversion) is pushed."""
+    targets = [expect(item, UserCode, "a suppressed user code (#u)")
+               for item in pop_many(proc, pop_count(proc))]
+    data = pop_of(proc, Str, "a string").data
+    template = pop_of(proc, Str, "a format string").data
+    if assignments(template) > len(targets):
+        raise conversion_error(f"the format stores {assignments(template)} values, "
+                               f"{len(targets)} user codes are given")
+    values, count = c_decode(template, data)
+    for target, value in zip(targets, values):
+        find(proc.scopes, user_key(target.code)).assign(value)
+    proc.push(Num(I2, count))
