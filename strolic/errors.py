@@ -31,6 +31,7 @@ class ExceptionKind(enum.Enum):
     FILE_ERROR = "file input/output error"
     FILE_OUTSIDE = "file outside the program directory"
     CONVERSION_ERROR = "conversion error"
+    DETECTION_WAITED = "an interrupt detection procedure waited"
     COMPUTER_ERROR = "other computer error"
     # robot-language exceptions (§9)
     OUT_OF_OPERATING_REGION = "outside the operating region"

@@ -7,13 +7,15 @@ The subset of the BASIC image that is implemented is written down in README.md (
 from __future__ import annotations
 
 import re
-from decimal import ROUND_HALF_UP, Decimal
+from decimal import ROUND_HALF_UP, Context, Decimal
 
 from .codes import I2, I4, INT_BITS, R4, R8, Num, Str, make_number
 from .errors import ExceptionKind as K, StrolicError, fail
 from .literals import format_real32
 
 Scalar = Num | Str
+EXACT = Context(prec=1000)      # enough digits for every R8 with its places
+MAX_WIDTH = 65535               # of a C conversion: wider is a conversion error
 
 
 def conversion_error(detail: str) -> StrolicError:
@@ -29,7 +31,7 @@ def decimal_of(num: Num) -> Decimal:
 
 def round_to(value: Decimal, places: int) -> Decimal:
     """Half away from zero (Annex 1 §6), to ``places`` decimals."""
-    return value.quantize(Decimal(1).scaleb(-places), rounding=ROUND_HALF_UP)
+    return value.quantize(Decimal(1).scaleb(-places), rounding=ROUND_HALF_UP, context=EXACT)
 
 
 # ==== BASIC style: PRINT USING images ============================================================
@@ -269,6 +271,8 @@ def c_encode(template: bytes, values: list[Scalar]) -> bytes:
         if precision == b"*":
             number = _integer(take("a * precision"), b"*")
             precision = str(number).encode() if number >= 0 else None
+        if any(part and part != b"*" and int(part) > MAX_WIDTH for part in (width, precision)):
+            raise conversion_error(f"a width or precision above {MAX_WIDTH}")
         argument = _c_argument(conversion, take(f"%{conversion.decode()}"))
         spec = b"%" + flags + (width or b"") + (b"." + precision if precision is not None
                                                  else b"") + (b"d" if conversion == b"u"

@@ -12,7 +12,8 @@ from typing import Callable
 
 from .functions import arithmetic as ar, bits, concurrency as cc, control as ct, data as dt
 from .functions import geometry as ge, strings as st, system as sy, system_time as tm
-from .functions import system_files as fl, system_format as fm, system_io as io
+from .functions import system_files as fl, system_format as fm, system_interrupts as it
+from .functions import system_io as io
 from .codes import I1, I2, I4, R4, R8
 
 
@@ -193,14 +194,14 @@ HOST_FUNCTIONS = [
     op(0xEE0B, "DOUT", "port data --", io.dout),
     op(0xEE0C, "DIN", "port -- data", io.din),
     op(0xEE0D, "IOWAIT", "port mask cond timeout -- masked tflag", io.iowait),
-    op(0xEE0E, "ACT", "level --"),
-    op(0xEE0F, "ACTRS", "level --"),
-    op(0xEE10, "REACT", "--"),
-    op(0xEE11, "ACTCODE", "code level detproc --"),
-    op(0xEE12, "ACTION", "code handler --"),
-    op(0xEE13, "TIMER", "timeout --"),
-    op(0xEE14, "RTIMER", "--"),
-    op(0xEE15, "TACTION", "handler --"),
+    op(0xEE0E, "ACT", "level --", it.act),
+    op(0xEE0F, "ACTRS", "level --", it.actrs),
+    op(0xEE10, "REACT", "--", it.react),
+    op(0xEE11, "ACTCODE", "code level detproc --", it.actcode),
+    op(0xEE12, "ACTION", "code handler --", it.action),
+    op(0xEE13, "TIMER", "timeout --", it.timer),
+    op(0xEE14, "RTIMER", "--", it.rtimer),
+    op(0xEE15, "TACTION", "handler --", it.taction),
     op(0xEE16, "FSTAT", "file -- status:I2", fl.fstat),
     op(0xEE17, "OUTPUT", "file data --", fl.output),
     op(0xEE18, "INPUT", "file -- data", fl.input_),

@@ -11,11 +11,13 @@ from .codec import CodeKind, decode, decode_function
 from .codes import Function, Num, UserCode, is_user_code, user_code_of, user_key
 from .errors import ExceptionKind as K, StrolicError, fail
 from .host import Host
+from .interrupts import Interrupts
 from .process import (BUILTIN, CYCLE_WAIT, INDIRECT, PUSH, USER, WAIT, Frame, Process,
                       State)
 from .variables import Scope, find
 
 SLICE = 200              # instructions a process runs before the scheduler looks again
+INTERRUPT_PRIORITY = float("-inf")   # interrupt processes go before every process
 DEFAULT_EPS = 1e-6
 
 
@@ -48,7 +50,8 @@ class VM:
         self.elbow = 0.0                   # arm angle of a 7-axis arm, degree
         self.flags: set[int] = set()       # event flags that are on
         self.channels: dict[int, object] = {}
-        self.processes: dict[int, Process] = {}
+        self.processes: dict[int | str, Process] = {}
+        self.interrupts = Interrupts()
         self.close_files()
 
     def close_files(self) -> None:
@@ -120,6 +123,7 @@ class VM:
         self.executed = 0
         try:
             while main.state is not State.DONE:
+                self.interrupts.poll(self)
                 proc = self._pick()
                 if proc is None:
                     self._idle()
@@ -173,7 +177,7 @@ class VM:
     def _idle(self) -> None:
         """Nothing can run: sleep until a cyclic start or timed wait is due, or report the
         deadlock."""
-        due = self._due_times()
+        due = self._due_times() + self.interrupts.due(self, self.host.now())
         if not due:
             frame = self.main.frame
             code = frame.codes[frame.pc] if frame.pc < len(frame.codes) else None
@@ -183,7 +187,8 @@ class VM:
 
     def finish(self, proc: Process) -> None:
         """A process's root function returned: wait for its next cycle or end."""
-        self.changed()
+        if self.processes.get(proc.number) is proc:    # not an interrupt detection procedure
+            self.changed()
         if proc.period:
             proc.state = State.WAITING
             proc.blocked_at = CYCLE_WAIT
@@ -254,8 +259,35 @@ class VM:
         if frame.function is not None:
             name += f" (in function {frame.name})"
         if proc.number:
-            name += f" (process {proc.number})"
+            name += f" ({proc.name})"
         return error.located(name, frame.origin + offset)
+
+    # ---- interrupt processes (interrupts.py) ----------------------------------------------------
+    def handler_running(self, label: str) -> bool:
+        proc = self.processes.get(label)
+        return proc is not None and proc.state is not State.DONE
+
+    def start_handler(self, label: str, function: Function) -> None:
+        """An interrupt's action as a process that goes before every other."""
+        proc = Process(label, self.function_frame(function, label),
+                       self.scopes_for_new_process())
+        proc.priority = INTERRUPT_PRIORITY
+        self.processes[label] = proc
+        self.changed()
+
+    def detect(self, function: Function, label: str) -> bool:
+        """Run an interrupt detection procedure to its end: is its result true?"""
+        proc = Process(f"{label} detection", self.function_frame(function, label),
+                       self.scopes_for_new_process())
+        while proc.state is State.RUNNING:
+            self._execute(proc, SLICE)
+        if proc.state is not State.DONE:
+            raise StrolicError(K.DETECTION_WAITED, "it must end without waiting",
+                               function=proc.name, offset=function.origin)
+        if not proc.stack or not isinstance(proc.stack[-1], Num):
+            raise StrolicError(K.TYPE_MISMATCH, "an interrupt detection procedure must leave "
+                               "a logical value", function=proc.name, offset=function.origin)
+        return proc.stack[-1].value != 0
 
     # ---- frames and calls -----------------------------------------------------------------------
     def fall_off(self, proc: Process) -> None:

@@ -18,6 +18,10 @@ AREA, BRANCH, DEAD = K.AREA_ERROR, K.BRANCH_OUT_OF_FUNCTION, K.DEADLOCK
 FILE, OUTSIDE, CONVERSION = K.FILE_ERROR, K.FILE_OUTSIDE, K.CONVERSION_ERROR
 T, F = "I2:1", "I2:0"          # logical values
 READ1 = "1 FCLOSE 1 1 FOPEN"   # after writing file 1: read it from the start
+IRQ = ("#x 0 STORE #g Fn{ 1 DIN 1 AND END } STORE #h Fn{ #x x INC STORE 9 ESIG END } STORE "
+       "5 1 #g ACTCODE 5 #h ACTION")
+TICK = "#h Fn{ #x x INC STORE 9 ESIG END } STORE"    # a timer action
+PAUSE = "2 1 1 5 IOWAIT DROP DROP"                   # 5 ms on an input that stays off
 
 
 class Warns(list):
@@ -450,6 +454,42 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
                 ('"%d" "99999999999" #x 1 DECODE2', CONVERSION),
                 ('"%d" "1" 5 1 DECODE2', TYPE), ('"%d" "1" #%2000 1 DECODE2', UNDEF),
                 ('"%d" 1 #x 1 DECODE2', TYPE)],
+    # ---- EE: interrupts (IRQ: code 5 of level 1 is input 1 bit 0; its action counts in x and
+    # sets flag 9) and the timer interrupt ------------------------------------------------------
+    "ACT": [(f"{IRQ} 1 ACT 1 1 DOUT 9 EWAIT x", ["1"]), (f"{IRQ} 1 1 DOUT {PAUSE} x", ["0"]),
+            (f"{IRQ} 2 ACT 1 1 DOUT {PAUSE} x", ["0"]), ("0 ACT", UNDEF), ("1.0 ACT", TYPE)],
+    "ACTRS": [(f"{IRQ} 1 ACT 1 ACTRS 1 1 DOUT {PAUSE} x", ["0"]),
+              (f"{IRQ} 1 ACT 2 ACT 0 ACTRS 1 1 DOUT {PAUSE} x", ["0"]),
+              (f"{IRQ} 1 ACT 2 ACTRS 1 1 DOUT 9 EWAIT x", ["1"]), ("-1 ACTRS", UNDEF)],
+    "REACT": [(f"{IRQ} 1 ACT 1 ACTRS REACT 1 1 DOUT 9 EWAIT x", ["1"]),
+              (f"{IRQ} 1 ACT 2 ACT 0 ACTRS REACT 1 1 DOUT 9 EWAIT x", ["1"]),
+              (f"{IRQ} 1 ACT 1 ACTRS REACT REACT 1 ACTRS REACT 2 ACTRS REACT 1 1 DOUT 9 EWAIT x",
+               ["1"]),
+              (f"{IRQ} 1 ACT 1 1 DOUT 9 EWAIT {PAUSE} x", ["1"]),
+              ("#x 0 STORE 5 1 Fn{ 1 END } ACTCODE "
+               "5 Fn{ #x x INC STORE x 3 LT >r BRT 9 ESIG END r: REACT END } ACTION "
+               "1 ACT 9 EWAIT x", ["3"])],
+    "ACTCODE": [("5 1 Fn{ 1 END } ACTCODE 5 Fn{ 9 ESIG END } ACTION 1 ACT 9 EWAIT 7", ["7"]),
+                (f"{IRQ} 5 3 #g ACTCODE 1 ACT 1 1 DOUT {PAUSE} 3 ACT 9 EWAIT x", ["1"]),
+                ("5 1 7 ACTCODE", TYPE), ("5 0 Fn{ 1 END } ACTCODE", UNDEF), ("5.0 1 Fn{ 1 END } ACTCODE", TYPE),
+                ("#g Fn{ END } STORE 5 1 #g ACTCODE 5 #g ACTION 1 ACT 9 EWAIT", TYPE),
+                ("5 1 Fn{ 3 EWAIT 1 END } ACTCODE 5 Fn{ END } ACTION 1 ACT 9 EWAIT",
+                 K.DETECTION_WAITED)],
+    "ACTION": [(f"{IRQ} 5 Fn{{ #x 7 STORE 9 ESIG END }} ACTION 1 ACT 1 1 DOUT 9 EWAIT x",
+                ["7"]), ("5 1 Fn{ 1 END } ACTCODE 1 ACT 1 1 2 10 IOWAIT", [F, T]),
+               ("5 7 ACTION", TYPE), ("5 #%2000 ACTION", UNDEF), ("5 #x ACTION", TYPE)],
+    "TIMER": [(f"#x 0 STORE {TICK} #h TACTION 10 TIMER 9 EWAIT x", ["1"]),
+              (f"#x 0 STORE {TICK} #h TACTION R4:2.5 TIMER 9 EWAIT x", ["1"]),
+              (f"#x 0 STORE {TICK} #h TACTION 10 TIMER 0 TIMER {PAUSE} {PAUSE} {PAUSE} x",
+               ["0"]),
+              (f"#x 0 STORE {TICK} #h TACTION 5 TIMER 9 EWAIT {PAUSE} {PAUSE} x", ["1"]),
+              (f"10 TIMER {PAUSE} {PAUSE} {PAUSE} 1", ["1"]), ('"a" TIMER', TYPE)],
+    "RTIMER": [(f"{IRQ} 1 ACT Fn{{ 8 ESIG END }} TACTION 5 TIMER 8 EWAIT 1 1 DOUT {PAUSE} x "
+                "RTIMER 9 EWAIT x", ["0", "1"]),
+               (f"{IRQ} 1 ACT Fn{{ 8 ESIG END }} TACTION 5 TIMER 8 EWAIT RTIMER 1 ACTRS RTIMER "
+                f"1 1 DOUT {PAUSE} x", ["0"])],
+    "TACTION": [(f"#x 0 STORE Fn{{ #x 5 STORE 9 ESIG END }} TACTION 1 TIMER 9 EWAIT x",
+                 ["5"]), ("7 TACTION", TYPE), ("TACTION", UNDER)],
 }
 
 # Exceptions that Annex 1 Table 1 lists in a function's 例外 cell: each must have a case.

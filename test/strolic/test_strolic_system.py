@@ -179,3 +179,37 @@ def test_files_are_closed_when_the_program_stops_and_at_init(tmp_path: Path) -> 
     assert (tmp_path / "file1.txt").read_bytes() == b"kept "
     assert stack_of('2 2 FOPEN 2 "a" OUTPUT INIT 2 FSTAT', host=host) == ["I2:2"]
     assert (tmp_path / "file2.txt").read_bytes() == b"a "
+
+
+# ---- interrupts -----------------------------------------------------------------------------
+def test_an_interrupt_is_detected_between_slices_of_a_busy_program() -> None:
+    program = ("#x I4:0 STORE 5 1 Fn{ x 1000 GT END } ACTCODE 5 Fn{ #y x STORE #g 1 STORE END } "
+               "ACTION 1 ACT #g 0 STORE #f Fn{ top: #x x INC STORE g 0 EQU >top BRT END } STORE "
+               "f y 1000 GT y 1500 LT")
+    assert stack_of(program)[-2:] == ["I2:1", "I2:1"]       # at most a slice late
+
+
+def test_the_interrupted_processes_stand_still_while_the_action_runs() -> None:
+    action = ("Fn{ #y x STORE #h I2:0 STORE top: #h h INC STORE h I2:600 LT >top BRT "
+              "#y y x EQU STORE #g 1 STORE END }")
+    program = (f"#x I4:0 STORE #g 0 STORE 5 1 Fn{{ x 100 GT END }} ACTCODE 5 {action} ACTION "
+               "1 ACT #f Fn{ top: #x x INC STORE g 0 EQU >top BRT END } STORE f y")
+    assert stack_of(program)[-1] == "I2:1"
+
+
+def test_an_exception_in_an_action_names_the_interrupt() -> None:
+    error = error_of("5 1 Fn{ 1 END } ACTCODE 5 Fn{ 1 0 DIV END } ACTION 1 ACT 9 EWAIT")
+    assert error.kind is ExceptionKind.DIVISION_BY_ZERO
+    assert error.function == "DIV (in function interrupt 5) (interrupt 5)"
+
+
+def test_init_forgets_the_interrupts() -> None:
+    error = error_of("5 1 Fn{ 1 END } ACTCODE 5 Fn{ 9 ESIG END } ACTION 1 ACT INIT 9 EWAIT")
+    assert error.kind is ExceptionKind.DEADLOCK
+
+
+def test_the_timer_interrupt_fires_after_its_milliseconds() -> None:
+    host = ClockHost()
+    _, main = execute("Fn{ 9 ESIG END } TACTION 250 TIMER 9 EWAIT 1", host=host)
+    assert [item.value for item in main.stack] == [1]
+    assert host.time == pytest.approx(0.25)

@@ -164,12 +164,22 @@ def test_a_function_datum_can_be_started_directly() -> None:
 
 
 # ---- executing generated programs never fails with anything but a STROLIC exception ----------
+class ImpatientHost(ClockHost):
+    """Waits (IOWAIT, TIMER) pass in no time; a minute of them stops the program."""
+
+    def sleep(self, seconds: float) -> None:
+        super().sleep(seconds)
+        if self.time > 60:
+            raise StrolicError(K.DEADLOCK, "waited a minute for an input or a timer")
+
+
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(program_codes(), st.integers(0, 3))
 def test_random_programs_stop_only_with_strolic_exceptions(codes, declared) -> None:
     prelude = assemble("VAR #%1000 #%1001 #%1002 DCL #%1000 #%1001 STORE")
     try:
-        VM(max_stack=1000, max_return_depth=100).run(prelude + encode(codes), budget=5000)
+        VM(ImpatientHost(), max_stack=1000, max_return_depth=100).run(prelude + encode(codes),
+                                                                     budget=5000)
     except StrolicError as error:
         assert error.kind is not K.COMPUTER_ERROR, error.report()
 
