@@ -1,7 +1,9 @@
-"""What the VM asks of the world around it: output stream, console, clock, tasks, robot.
+"""What the VM asks of the world around it: output stream, console, clocks, digital I/O,
+communication ports, files, tasks, robot.
 
-The robot and system functions (EE, ED areas) will act through a subclass of ``Host``; a table
-row without a handler is dispatched to ``Host.call``.
+The system functions (EE area) use the small hooks below, whose defaults need no hardware
+(in-memory I/O, files in a program directory); the robot binding overrides them in a subclass.
+A table row without a handler (the ED area, for now) is dispatched to ``Host.call``.
 """
 from __future__ import annotations
 
@@ -88,7 +90,7 @@ class Host:
         self.output: list[bytes] = []
         self.shared: dict[int, int] = {}
         self.time_offset = timedelta(0)        # STIME/SDATE: set time of day − system time
-        self.clock_origin = self.now()         # CLRCLK: the moment the internal clock read 0
+        self.clock_origin = 0.0                # CLRCLK: when (host time) the clock read 0
         self.io = MemoryIO()
         self.port_settings = {1: PortSettings(), 2: PortSettings()}   # communication ports
         self.port_files = {101: 1, 102: 2}     # file number → communication port
@@ -124,7 +126,7 @@ class Host:
         self.time_offset = value - datetime.now()
 
     def clock_ms(self) -> int:
-        """The internal clock in milliseconds since the host started or CLRCLK."""
+        """The internal clock: milliseconds of ``now()`` since its zero, or since CLRCLK."""
         return int((self.now() - self.clock_origin) * 1000)
 
     def clear_clock(self) -> None:
