@@ -54,14 +54,18 @@ class VM:
         self.interrupts = Interrupts()
         self.close_files()
 
-    def close_files(self) -> None:
-        """At INIT and at the end of every run: the files the program left open are closed."""
+    def close_files(self, report: bool = False) -> None:
+        """At INIT and at the end of every run: the files the program left open are closed;
+        with ``report`` (a run that ended normally) a failure is raised once all are closed."""
         files, self.files = self.files, {}
+        failure = None
         for file in files.values():
             try:
                 file.close()
-            except StrolicError:
-                pass                       # the run is over: nothing left to stop
+            except StrolicError as error:
+                failure = failure or error
+        if failure is not None and report:
+            raise failure
 
     def changed(self) -> None:
         self.generation += 1
@@ -129,6 +133,7 @@ class VM:
                     self._idle()
                     continue
                 self._execute(proc, SLICE)
+            self.close_files(report=True)
         except StrolicError as error:
             self.host.stop(error)
             raise

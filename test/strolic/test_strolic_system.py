@@ -1,6 +1,7 @@
 """The system functions (EE area) on the default host: clocks, warnings, I/O, files, interrupts."""
 from __future__ import annotations
 
+import io
 from datetime import datetime, timedelta
 from pathlib import Path
 
@@ -213,3 +214,16 @@ def test_the_timer_interrupt_fires_after_its_milliseconds() -> None:
     _, main = execute("Fn{ 9 ESIG END } TACTION 250 TIMER 9 EWAIT 1", host=host)
     assert [item.value for item in main.stack] == [1]
     assert host.time == pytest.approx(0.25)
+
+
+def test_a_file_that_fails_to_close_at_the_end_is_reported() -> None:
+    class Full(io.BytesIO):
+        def close(self) -> None:
+            raise OSError(28, "No space left on device")
+
+    class DiskFull(RecordingHost):
+        def open_file(self, number: int, mode: str):
+            return Full()
+
+    error = error_of('1 2 FOPEN 1 "x" OUTPUT', host=DiskFull())
+    assert error.kind is ExceptionKind.FILE_ERROR and "No space left" in error.detail
