@@ -615,10 +615,13 @@ class ArmCore:
                               f"{qs_deg[k, j]:.3f}°, limit [{lim[j, 0]:g}, {lim[j, 1]:g}]°")
 
     # === queueing ======================================================================================
-    def _queue_joint_move(self, goal_of: Callable[[ArmSetpoint], np.ndarray], label: str) -> dict:
-        """A PTP move to goal_of(start) (rad): synchronized trapezoid at the joint speed ratio."""
-        speed = np.radians(self.max_speed_joint) * self.speed_joint / 100.0
-        ramp = self.accel_time_joint
+    def _queue_joint_move(self, goal_of: Callable[[ArmSetpoint], np.ndarray], label: str,
+                          speed_ratio: float | None = None, ramp: float | None = None) -> dict:
+        """A PTP move to goal_of(start) (rad): synchronized trapezoid at the joint speed ratio
+        and accel time (or the given ones: STROLIC programs keep their own)."""
+        ratio = self.speed_joint if speed_ratio is None else speed_ratio
+        speed = np.radians(self.max_speed_joint) * ratio / 100.0
+        ramp = self.accel_time_joint if ramp is None else ramp
         frames = self.frames
 
         def plan(start: ArmSetpoint) -> ArmMotion:
@@ -674,13 +677,15 @@ class ArmCore:
         return self._queue_joint_move(goal_of, label)
 
     def _queue_cartesian(self, path_of: Callable[[np.ndarray], LinePath], label: str, *,
-                         psi: float | None = None, turn: float = 0.0) -> dict:
+                         psi: float | None = None, turn: float = 0.0,
+                         speed_ratio: float | None = None, ramp: float | None = None) -> dict:
         """A CP move along path_of(start pose); the elbow ends at arm angle `psi`, or (Rel) is
-        turned by `turn` (rad) from where it starts."""
+        turned by `turn` (rad) from where it starts. Speed ratio and accel time: the port's
+        settings unless given."""
         frames = self.frames
         v, w = self.max_speed_cartesian
-        ratio = self.speed_cartesian / 100.0
-        ramp = self.accel_time_cartesian
+        ratio = (self.speed_cartesian if speed_ratio is None else speed_ratio) / 100.0
+        ramp = self.accel_time_cartesian if ramp is None else ramp
         limits = CartesianLimits(
             speed=v * ratio / 1000.0, angular_speed=math.radians(w * ratio), ramp=ramp,
             joint_velocity=np.radians(self.max_speed_joint),

@@ -140,6 +140,8 @@ class Device:
                 self.queued_end = self.hold
                 return
             if self._stop_at is None:
+                # a move cut short to hand over to the next (a blend) stops along its whole path
+                cur.motion = getattr(cur.motion, "unblended", cur.motion)
                 self._stop_at = min(cur.motion.duration, self.t + self.rate * self.rate * ramp / 2)
             self._set_rate(0.0, ramp)
             self.queued_end = cur.motion.at(self._stop_at)

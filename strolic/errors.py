@@ -42,6 +42,7 @@ class ExceptionKind(enum.Enum):
     SERVO_ERROR = "servo error"
     COMMUNICATION_ERROR = "communication error"
     CONTROLLER_ERROR = "other controller error"
+    STOPPED = "stopped by the operator"    # the run was canceled (robot binding)
 
 
 class StrolicError(Exception):

@@ -132,6 +132,10 @@ class Host:
     def clear_clock(self) -> None:
         self.clock_origin = self.now()
 
+    def check(self, vm) -> None:
+        """Called by the scheduler between slices and waits: raise a StrolicError to stop the
+        program for what happened outside it (a motion error, an operator's stop)."""
+
     def stop(self, error) -> None:
         """Program execution stopped on an exception (§4.5): robot motion must stop too."""
 

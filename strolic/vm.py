@@ -128,6 +128,10 @@ class VM:
         try:
             while main.state is not State.DONE:
                 self.interrupts.poll(self)
+                try:
+                    self.host.check(self)
+                except StrolicError as error:
+                    raise self._at_main(error)
                 proc = self._pick()
                 if proc is None:
                     self._idle()
@@ -184,11 +188,14 @@ class VM:
         deadlock."""
         due = self._due_times() + self.interrupts.due(self, self.host.now())
         if not due:
-            frame = self.main.frame
-            code = frame.codes[frame.pc] if frame.pc < len(frame.codes) else None
-            raise self._locate(fail(K.DEADLOCK, "every process waits and nothing can wake them"),
-                               self.main, frame, code)
+            raise self._at_main(fail(K.DEADLOCK, "every process waits and nothing can wake them"))
         self.host.sleep(min(due) - self.host.now())
+
+    def _at_main(self, error: StrolicError) -> StrolicError:
+        """An exception that is no instruction's: located where the program (process 0) is."""
+        frame = self.main.frame
+        code = frame.codes[frame.pc] if frame.pc < len(frame.codes) else None
+        return self._locate(error, self.main, frame, code)
 
     def finish(self, proc: Process) -> None:
         """A process's root function returned: wait for its next cycle or end."""

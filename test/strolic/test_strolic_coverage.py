@@ -1,6 +1,7 @@
-"""The coverage table: no function of EF00–EF8E or EE00–EE22 may be silently missing."""
+"""The coverage table: no function of EF00–EF8E, EE00–EE22 or ED00–ED23 may be silently missing."""
 from __future__ import annotations
 
+import strolic_robot_cases as robot
 from strolic_cases import CASES, LISTED_EXCEPTIONS, LISTED_WARNINGS, Warns
 from strolic import opcodes
 from strolic.errors import ExceptionKind
@@ -40,8 +41,24 @@ def test_arithmetic_cases_cover_type_promotion() -> None:
         assert any(":" in program or "." in program for program, _ in CASES[mnemonic]), mnemonic
 
 
+def test_every_robot_function_has_a_normal_case_and_its_listed_exceptions() -> None:
+    """ED00–ED23 (strolic_robot_cases.py): a case that ends normally without an error flag,
+    and a case for every exception the standard lists (reported by the function's flag)."""
+    ed = {row.mnemonic for row in opcodes.TABLE if 0xED00 <= row.code <= 0xED23}
+    assert set(robot.CASES) == ed, ed ^ set(robot.CASES)
+    for mnemonic, cases in robot.CASES.items():
+        flags = {robot.NOT_READY, *robot.LISTED_FLAGS.get(mnemonic, ())}
+        assert any(isinstance(case[1], robot.Check) or isinstance(case[1], list)
+                   and not flags & set(case[1]) for case in cases), mnemonic
+    for mnemonic, listed in robot.LISTED_FLAGS.items():
+        for flag in listed:
+            assert any(isinstance(case[1], list) and flag in case[1]
+                       for case in robot.CASES[mnemonic]), (mnemonic, flag)
+
+
 def test_system_and_robot_function_rows() -> None:
-    """EE rows have handlers that use the host's hooks; ED rows wait for the robot binding."""
+    """EE rows have handlers that use the host's hooks; ED rows are the host's (the robot
+    binding, acti_motion/strolic_robot.py, dispatches them by mnemonic)."""
     host_rows = [row for row in opcodes.TABLE if row.code < 0xEF00]
     assert [row.code for row in host_rows] == (list(range(0xEE00, 0xEE23))
                                                + list(range(0xED00, 0xED24)))

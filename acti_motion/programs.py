@@ -1,0 +1,127 @@
+"""One run of a STROLIC program on the arm, without ROS: load (text form or code), run on the
+calling thread or a thread of its own, progress while it runs, cancel, and the result.
+
+A run ends when the program has ended *and* the motions it commanded are over (its end waits
+for them as `$WAIT` would); an exception (the program's, a motion error, a cancel) stops the
+program and the arm (`RobotHost.stop`).
+"""
+from __future__ import annotations
+
+import enum
+import threading
+from dataclasses import dataclass, field
+
+from acti_motion.arm import ArmCore
+from acti_motion.strolic_robot import ProgramDefaults, RobotHost
+from strolic.codec import decode
+from strolic.errors import ExceptionKind as K, StrolicError
+from strolic.host import MemoryIO
+from strolic.literals import format_value
+from strolic.process import State
+from strolic.text import assemble, format_code
+from strolic.vm import VM
+
+
+class Status(enum.IntEnum):
+    """How a run ended (the RunProgram action's result status)."""
+    FINISHED = 0
+    EXCEPTION = 1
+    CANCELED = 2
+    INVALID = 3          # the program did not load (assembly or code error)
+
+
+@dataclass
+class Progress:
+    program_counter: int = -1     # byte offset of the program's next code (process 0)
+    instructions: int = 0
+    state: str = "starting"
+    message: str = ""             # PAUSE's message while paused
+    motion_id: int = 0            # the arm's current motion (any source), its label and progress
+    motion_label: str = ""
+    progress: float = 0.0
+    queue_length: int = 0
+
+
+@dataclass
+class ProgramResult:
+    status: Status
+    error: StrolicError | None = None
+    stack: list[str] = field(default_factory=list)     # final data stack, bottom first
+    output: list[str] = field(default_factory=list)    # what the program sent (SYNC, RESULT)
+    console: list[str] = field(default_factory=list)   # TRACE, warnings, flags, PAUSE messages
+    instructions: int = 0
+    duration: float = 0.0                              # simulated seconds
+
+    @property
+    def report(self) -> str:
+        return self.error.report() if self.error is not None else ""
+
+
+def load(program: bytes | str) -> list:
+    """Decoded codes of a program in the text form (str) or as code (bytes); StrolicError when
+    it does not assemble or decode."""
+    return decode(assemble(program) if isinstance(program, str) else bytes(program))
+
+
+class ProgramRun:
+    """A program run on `arm`; `step` (tests) advances the simulation while the program waits."""
+
+    def __init__(self, arm: ArmCore, program: bytes | str, *, io: MemoryIO | None = None,
+                 step=None, defaults: ProgramDefaults | None = None, budget: int | None = None,
+                 echo: bool = False) -> None:
+        self.arm = arm
+        self.codes = load(program)
+        self.host = RobotHost(arm, io, step=step, defaults=defaults, echo=echo)
+        self.vm = VM(self.host)
+        self.budget = budget
+        self.result: ProgramResult | None = None
+        self._thread: threading.Thread | None = None
+
+    def run(self) -> ProgramResult:
+        """Run to the end on this thread."""
+        vm, host = self.vm, self.host
+        start = host.now()
+        try:
+            vm.run(self.codes, budget=self.budget)
+            host.wait_motions(vm)
+            status, error = Status.FINISHED, None
+        except StrolicError as e:
+            if host.state != "stopping":
+                host.stop(e)
+            status = Status.CANCELED if e.kind is K.STOPPED else Status.EXCEPTION
+            error = e
+        host.state = status.name.lower()
+        self.result = ProgramResult(
+            status, error, [format_value(item) for item in vm.main.stack] if vm.main else [],
+            [" ".join(format_code(code) for code in decode(data)) for data in host.output],
+            list(host.lines), vm.executed, host.now() - start)
+        return self.result
+
+    def start(self) -> None:
+        """Run on a thread of its own (`join`, `result`)."""
+        self._thread = threading.Thread(target=self.run, name="strolic-program", daemon=True)
+        self._thread.start()
+
+    def join(self, timeout: float | None = None) -> bool:
+        if self._thread is not None:
+            self._thread.join(timeout)
+            return not self._thread.is_alive()
+        return self.result is not None
+
+    def cancel(self) -> None:
+        """Stop the program and the arm (it decelerates); the run ends with CANCELED."""
+        self.host.cancel_event.set()
+
+    def progress(self) -> Progress:
+        vm, host = self.vm, self.host
+        out = Progress(instructions=vm.executed, state=host.state, message=host.message)
+        main = vm.main
+        if main is not None:
+            frame = main.frame
+            codes = frame.codes
+            out.program_counter = (frame.origin + codes[frame.pc][2] if frame.pc < len(codes)
+                                   else frame.origin + (codes[-1][2] + codes[-1][3] if codes else 0))
+            if host.state == "running" and main.state is State.WAITING:
+                out.state = "waiting"
+        out.motion_id, out.motion_label, out.progress, out.queue_length = self.arm.motion_status()
+        return out
