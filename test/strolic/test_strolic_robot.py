@@ -10,10 +10,12 @@ import numpy as np
 import pytest
 
 from acti_motion.arm import ArmConfig, ArmCore
+from acti_motion.executor import MotionExecutor
 from acti_motion.programs import ProgramRun, Status
+from acti_sim.world import World
 from sim_fixtures import executor  # noqa: F401
 from strolic.errors import ExceptionKind as K
-from strolic_robot_cases import CASES, WORK, Check
+from strolic_robot_cases import CASES, WORK, Check, numbers
 
 MAX_SIM_SECONDS = 60.0
 
@@ -60,3 +62,168 @@ def test_case(arm, executor, program, expected, options):  # noqa: F811
             assert expected(result.stack, arm), (expected.what, result.stack, result.console)
         else:
             assert result.stack == expected, result.console
+
+
+# --- what the simulation shows -------------------------------------------------------------------
+SQUARE = ("HERE Vec(0 150 0) DEV HERE Vec(0 150 -150) DEV HERE Vec(0 0 -150) DEV 3 #Pm(120) CONSA")
+CORNERS = np.array([[0, 150, 0], [0, 150, -150], [0, 0, -150]], float)
+
+
+def traced(arm, executor, text, **options):  # noqa: F811
+    """Run and record the measured control point (mm) at every step: result, times, points."""
+    log = []
+    executor.after_step(lambda world: log.append(
+        (world.time, arm.tool_pose(world.arm_positions())[:3, 3] * 1000.0)))
+    result = run(arm, executor, text, **options)
+    return result, np.array([t for t, _ in log]), np.array([p for _, p in log])
+
+
+def speeds(times, points):
+    return np.linalg.norm(np.diff(points, axis=0), axis=1) / np.diff(times)
+
+
+@pytest.mark.parametrize("move", ["ALMOVE", "AJMOVE"])
+def test_pose_sequence_stops_at_each_pose_without_sacc(arm, executor, move):  # noqa: F811
+    result, times, points = traced(arm, executor, f"300 SPEED 50 JSPEED {SQUARE} {move} -1 $WAIT")
+    assert result.status is Status.FINISHED and result.stack == ["I2:0"] * 4, result.console
+    start, v = points[0], speeds(times, points)
+    for corner in CORNERS[:2]:
+        k = int(np.argmin(np.linalg.norm(points - (start + corner), axis=1)))
+        assert np.linalg.norm(points[k] - (start + corner)) < 0.5
+        assert v[k - 15:k + 15].min() < 2.0                   # it stops there
+    assert np.linalg.norm(points[-1] - (start + CORNERS[2])) < 0.2
+
+
+@pytest.mark.parametrize("move, min_speed", [("ALMOVE", 40.0), ("AJMOVE", 12.0)])
+def test_sacc_blends_through_via_points_without_stopping(move, min_speed):
+    durations = {}
+    for sacc in (0, 20):
+        world = World()
+        try:
+            sim = MotionExecutor(world, real_time_factor=0.0)
+            blended = ArmCore(sim, ArmConfig(queue_size=8, initial_joints_deg=WORK))
+            assert blended.servo_on().ok
+            result, times, points = traced(blended, sim, f"300 SPEED 50 JSPEED {sacc} SACC "
+                                                         f"{SQUARE} {move} -1 $WAIT")
+        finally:
+            world.close()
+        assert result.status is Status.FINISHED and result.stack == ["I2:0"] * 5, result.console
+        durations[sacc] = result.duration
+    start, v = points[0], speeds(times, points)
+    moving = np.flatnonzero(v > 0.3 * v.max())
+    assert v[moving[0]:moving[-1]].min() > min_speed           # never stops between the ends
+    for corner in CORNERS[:2]:                                  # passes within the radius
+        assert np.min(np.linalg.norm(points - (start + corner), axis=1)) < 20.0
+    assert np.linalg.norm(points[-1] - (start + CORNERS[2])) < 0.2
+    assert durations[20] < durations[0] - 0.2
+
+
+def test_wait_returns_when_the_motion_is_over_or_at_its_timeout(arm, executor):  # noqa: F811
+    result = run(arm, executor, "Ar[R8 30 0 0 0 0 0 0] IDRIVE DROP CLOCK 0.2 $WAIT CLOCK "
+                                "-1 $WAIT JHERE")
+    assert result.status is Status.FINISHED, result.report
+    t0, status, t1, done, joints = result.stack
+    assert status == "I2:1" and done == "I2:0"
+    assert int(t1.split(":")[-1]) - int(t0.split(":")[-1]) == pytest.approx(200, abs=10)
+    assert abs(numbers(joints)[0] - 30.0) < 0.05           # it waited for the end of the move
+
+
+def test_delay_counts_simulated_time_and_stands_still_during_an_interrupt(arm, executor):  # noqa: F811
+    plain = run(arm, executor, "CLOCK 0.5 DELAY DROP CLOCK EXCH SUB")
+    assert int(plain.stack[-1].split(":")[-1]) == pytest.approx(500, abs=10)
+    interrupted = run(arm, executor, "Fn{ 0.3 DELAY DROP END } TACTION 100 TIMER "
+                                     "CLOCK 0.5 DELAY DROP CLOCK EXCH SUB")
+    assert int(interrupted.stack[-1].split(":")[-1]) == pytest.approx(800, abs=20)
+
+
+def test_pause_holds_the_arm_until_the_operator_resumes(arm, executor):  # noqa: F811
+    seen = []
+    result = run(arm, executor, 'Ar[R8 40 0 0 0 0 0 0] IDRIVE DROP 0.3 DELAY DROP '
+                                '"check the part" PAUSE -1 $WAIT JHERE', resume_after=1.5,
+                 hook=lambda: seen.append((arm.state_word(), np.abs(
+                     executor.world.arm_velocities()).max())))
+    assert result.status is Status.FINISHED and result.stack[:2] == ["I2:0", "I2:0"]
+    assert "PAUSE: check the part" in result.console and result.duration > 1.5
+    paused = [speed for word, speed in seen if word & 0x10]
+    assert len(paused) > 200 and max(paused[150:]) < 0.01    # decelerated, then held
+    assert abs(numbers(result.stack[-1])[0] - 40.0) < 0.05   # and then went on
+
+
+def arm_rest_after(executor, arm, since):  # noqa: F811
+    """Simulated seconds from `since` until the measured joints are still."""
+    t0 = executor.world.time
+    while np.abs(executor.world.arm_velocities()).max() > 0.005:
+        executor.step()
+        assert executor.world.time - t0 < 5.0
+    return executor.world.time - since
+
+
+@pytest.mark.parametrize("event, kind", [
+    ("soft limit", K.OUT_OF_OPERATING_REGION), ("stop", K.ROBOT_ERROR),
+    ("servo off", K.SERVO_ERROR), ("cancel", K.STOPPED)])
+def test_a_motion_error_or_cancel_stops_the_program_and_the_arm(arm, executor, event, kind):  # noqa: F811
+    program = ProgramRun(arm, "80 JSPEED DROP Ar[R8 0 40 0 0 0 0 0] IDRIVE DROP "
+                              "Ar[R8 0 -40 0 0 0 0 0] IDRIVE DROP -1 $WAIT", step=None)
+    when = {}
+
+    def step():
+        executor.step()
+        if "at" not in when and executor.world.time > 0.6:
+            when["at"] = executor.world.time
+            if event == "soft limit":
+                z = arm.tool_pose(arm.feedback_joints)[2, 3] * 1000.0
+                assert arm.set_soft_limit_cartesian((2000, -2000), (2000, -2000),
+                                                    (2000, z - 2.0)).ok
+            elif event == "stop":
+                assert arm.stop().ok
+            elif event == "servo off":
+                assert arm.servo_off().ok
+            else:
+                program.cancel()
+    program.host.step = step
+    result = program.run()
+    assert result.status is (Status.CANCELED if event == "cancel" else Status.EXCEPTION)
+    assert result.error.kind is kind, result.report
+    assert result.stack == ["-1"]                           # stopped in $WAIT
+    assert not arm.device.busy or arm.device.stopping
+    assert arm_rest_after(executor, arm, when["at"]) < arm.accel_time_joint + 0.25
+
+
+def test_a_program_exception_stops_the_arm(arm, executor):  # noqa: F811
+    result = run(arm, executor, "Ar[R8 60 0 0 0 0 0 0] IDRIVE DROP 0.5 DELAY DROP 1 0 DIV")
+    assert result.status is Status.EXCEPTION and result.error.kind is K.DIVISION_BY_ZERO
+    assert "DIV" in result.report and arm.device.queue_length == 0
+    since = executor.world.time
+    assert arm_rest_after(executor, arm, since) < arm.accel_time_joint + 0.25
+    assert abs(np.degrees(arm.feedback_joints[0]) - 60.0) > 10.0   # it did not go on
+
+
+def test_a_full_queue_makes_the_program_wait(arm, executor):  # noqa: F811
+    moves = " ".join(["Ar[R8 2 0 0 0 0 0 0] IDRIVE"] * 12)
+    result = run(arm, executor, f"100 JSPEED DROP {moves} -1 $WAIT JHERE")
+    assert result.status is Status.FINISHED and result.stack[:13] == ["I2:0"] * 13
+    assert abs(numbers(result.stack[-1])[0] - 24.0) < 0.05
+
+
+def test_program_and_service_motions_run_in_the_order_sent(arm, executor):  # noqa: F811
+    sent = {}
+
+    def hook():
+        if "id" not in sent and arm.device.last_id >= 1:
+            sent["id"] = arm.move_ptp_joint_rel([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 10.0])
+    assert arm.set_speed_joint(50).ok
+    labels = []
+    executor.after_step(lambda world: labels.append(arm.motion_status()[1]))
+    result = run(arm, executor, "Ar[R8 10 0 0 0 0 0 0] IDRIVE DROP 0.1 DELAY DROP "
+                                "Ar[R8 0 -10 0 0 0 0 0] IDRIVE DROP -1 $WAIT JHERE", hook=hook)
+    assert result.status is Status.FINISHED and sent["id"].ok
+    order = [label for i, label in enumerate(labels) if label and label != labels[i - 1]]
+    assert order == ["IDRIVE", "move_ptp_joint_rel", "IDRIVE"]
+    assert np.allclose(numbers(result.stack[-1]), np.add(WORK, [10, -10, 0, 0, 0, 0, 10]),
+                       atol=0.05)
+
+
+def test_status_port_and_outputs(arm, executor):  # noqa: F811
+    result = run(arm, executor, "16 DIN 3 5 DOUT 3 DIN 16 1 DOUT")
+    assert result.stack == ["I2:17", "I2:5"]                 # servo on, hand closed
+    assert any("output port 16 does not exist" in line for line in result.console)
