@@ -1,5 +1,5 @@
 """ArmNode: the thin ROS adapter of `acti_motion.arm.ArmCore`: the operation table's services,
-the ~/wait_motion and ~/move actions, and the ~/state topic."""
+the ~/wait_motion, ~/move and ~/run_program (STROLIC) actions, and the ~/state topic."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -15,8 +15,10 @@ from acti_bringup.parameters import declare_config
 from acti_bringup.simulation import Simulation
 from acti_middle_node.actions import ActionConfig, MotionActions
 from acti_middle_node.operations import OPERATIONS
+from acti_middle_node.program_action import ProgramAction
 from acti_motion.arm import ArmConfig, ArmCore
 from acti_motion.replies import Reply
+from acti_motion.strolic_robot import ProgramDefaults
 
 
 @dataclass
@@ -44,6 +46,8 @@ class ArmNode(Node):
             raise ValueError("feedback_rate_hz and state_rate_hz must be > 0, "
                              "max_action_goals >= 1")
         self.actions = MotionActions(self, self.core, group, actions)
+        self.programs = ProgramAction(self, self.core, group, actions.feedback_rate_hz,
+                                      declare_config(self, ProgramDefaults))
         self._state = self.create_publisher(ArmState, "~/state", 10)
         self.create_timer(1.0 / topics.state_rate_hz, self._publish_state, callback_group=group)
 

@@ -27,7 +27,9 @@ def strolic(*args: str) -> subprocess.CompletedProcess:
 
 
 def test_every_example_is_checked() -> None:
-    assert sorted(p.name for p in EXAMPLES.glob("*.sasm")) == sorted(EXPECTED_STACKS)
+    """robot_*.sasm move the arm: test_program_ros.py runs them through ~/run_program."""
+    assert sorted(p.name for p in EXAMPLES.glob("*.sasm")
+                  if not p.name.startswith("robot_")) == sorted(EXPECTED_STACKS)
 
 
 @pytest.mark.parametrize("name", sorted(EXPECTED_STACKS))

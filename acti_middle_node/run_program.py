@@ -1,0 +1,108 @@
+"""Run a STROLIC program file on the running arm node and show its progress:
+
+    python -m acti_middle_node.run_program FILE [--node /acti_middle_node] [--budget N] [--quiet]
+
+FILE is the text form (.sasm, .txt, .strolic) or raw code (anything else); it is assembled here
+and sent as code to ~/run_program. Progress lines show the program counter (byte offset, as
+`python -m strolic dis --offsets` numbers the codes), the state and the arm's motion; at the end
+the console lines, what the program sent, the final stack and the exception report if any.
+Ctrl-C cancels the run (the program and the arm stop). Exit status: 0 the program finished,
+1 an exception stopped it, 2 it was canceled or did not load, 3 no node answered.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import rclpy
+from acti_msgs.action import RunProgram
+from rclpy.action import ActionClient
+
+from strolic.__main__ import load_program
+from strolic.errors import StrolicError
+
+SERVER_TIMEOUT = 30.0
+
+
+def describe(feedback: RunProgram.Feedback) -> str:
+    motion = (f"motion {feedback.motion_id} {feedback.motion_label} "
+              f"{100 * feedback.progress:.0f} % (+{feedback.queue_length} queued)"
+              if feedback.motion_id else "arm at rest")
+    state = f"{feedback.state}: {feedback.message}" if feedback.message else feedback.state
+    return (f"@{feedback.program_counter:<6} {feedback.instructions:>8} instructions  "
+            f"{state:<18} {motion}")
+
+
+def report(result: RunProgram.Result, out=sys.stdout) -> None:
+    for line in result.console:
+        print(f"console: {line}", file=out)
+    for line in result.output:
+        print(f"output: {line}", file=out)
+    print(f"stack: {' '.join(result.stack) if result.stack else '(empty)'}", file=out)
+    status = {RunProgram.Result.FINISHED: "finished", RunProgram.Result.EXCEPTION: "exception",
+              RunProgram.Result.CANCELED: "canceled", RunProgram.Result.INVALID: "invalid"}
+    print(f"{status.get(result.status, result.status)} after {result.instructions} "
+          f"instructions, {result.duration:.2f} s (simulated)", file=out)
+    if result.exception:
+        print(result.exception, file=out)
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        code = load_program(Path(args.program))
+    except StrolicError as error:
+        print(f"{args.program}: {error.report()}", file=sys.stderr)
+        return 2
+    rclpy.init()
+    node = rclpy.create_node("run_program")
+    client = ActionClient(node, RunProgram, f"{args.node.rstrip('/')}/run_program")
+    try:
+        if not client.wait_for_server(timeout_sec=SERVER_TIMEOUT):
+            print(f"no {args.node}/run_program answered in {SERVER_TIMEOUT:g} s", file=sys.stderr)
+            return 3
+        last = [None]
+
+        def show(message) -> None:
+            """A line when the state or the motion changes (every message with --verbose)."""
+            f = message.feedback
+            key = (f.state, f.message, f.motion_id, int(4 * f.progress))
+            if args.verbose or not args.quiet and key != last[0]:
+                print(describe(f), flush=True)
+            last[0] = key
+        goal = RunProgram.Goal(code=list(code), budget=args.budget)
+        sent = client.send_goal_async(goal, feedback_callback=show)
+        rclpy.spin_until_future_complete(node, sent)
+        handle = sent.result()
+        if not handle.accepted:
+            print("the node refused the program (another one is running?)", file=sys.stderr)
+            return 2
+        done = handle.get_result_async()
+        try:
+            rclpy.spin_until_future_complete(node, done)
+        except KeyboardInterrupt:
+            print("canceling ...", file=sys.stderr)
+            rclpy.spin_until_future_complete(node, handle.cancel_goal_async())
+            rclpy.spin_until_future_complete(node, done)
+        result = done.result().result
+        report(result)
+        return {RunProgram.Result.FINISHED: 0, RunProgram.Result.EXCEPTION: 1}.get(result.status, 2)
+    finally:
+        client.destroy()
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m acti_middle_node.run_program",
+                                     description=__doc__.split("\n\n")[0])
+    parser.add_argument("program", help="the program: text form (.sasm) or raw code")
+    parser.add_argument("--node", default="/acti_middle_node", help="the arm node's name")
+    parser.add_argument("--budget", type=int, default=0, help="instruction limit (0: none)")
+    parser.add_argument("--quiet", action="store_true", help="no progress lines")
+    parser.add_argument("--verbose", action="store_true", help="every feedback message")
+    return run(parser.parse_args(argv))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
