@@ -66,9 +66,9 @@ PLANES = {1: 2, 2: 0, 3: 1}    # CMOVE1 plane → its normal axis: xy → z, yz 
 
 @dataclass
 class ProgramDefaults:
-    """The modal settings a program starts with."""
-    jspeed: float = 20.0       # %
-    speed: float = 100.0       # mm/s
+    """The modal settings a program starts with (the node's parameters)."""
+    program_jspeed: float = 20.0       # JSPEED at the start of a program [%]
+    program_speed: float = 100.0       # SPEED at the start of a program [mm/s]
 
 
 class Flag(Exception):
@@ -174,7 +174,7 @@ class RobotHost(Host):
         self.step = step
         self.echo = echo
         self.lines: list[str] = []
-        self.jspeed, self.speed = d.jspeed, d.speed
+        self.jspeed, self.speed = d.program_jspeed, d.program_speed
         self.accel: tuple[str, float] | None = None     # ("percent" | "time", value)
         self.decel: tuple[str, float] | None = None
         self.accuracy = 0.0                               # SACC, mm
