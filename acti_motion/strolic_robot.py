@@ -187,6 +187,7 @@ class RobotHost(Host):
         self.message = ""
         self.cancel_event = threading.Event()
         self._alarms0 = {a.as_tuple() for a in arm.alarms}
+        self._fault: tuple[K, str] | None = None
         self._waits: dict[tuple, object] = {}
         self._frozen = 0.0                                # s of pause and interrupts (DELAY)
         self._last_check = self.now()
@@ -262,22 +263,29 @@ class RobotHost(Host):
 
     def _collect(self) -> None:
         """Forget the motions that are over; a new alarm or a discarded motion of the program
-        is an exception."""
+        is an exception (raised again at every later call: the program must stop)."""
+        if self._fault is None:
+            self._fault = self._find_fault()
+        if self._fault is not None:
+            raise fail(*self._fault)
+
+    def _find_fault(self) -> tuple[K, str] | None:
         arm, device = self.arm, self.arm.device
         new = [a for a in arm.alarms if a.as_tuple() not in self._alarms0]
         if new:
             self.abnormal = STATUS_ALARM
             kind = K.OUT_OF_OPERATING_REGION if new[0].code in (4, 5) else K.ROBOT_ERROR
-            raise fail(kind, f"alarm 0x{new[0].code:X}: {new[0].description}")
+            return kind, f"alarm 0x{new[0].code:X}: {new[0].description}"
         over = {i for i in self.pending if i <= device.retired_id}
         self.pending -= over
         lost = sorted(i for i in over if device.was_discarded(i))
-        if lost:
-            self.abnormal = STATUS_DISCARDED
-            if not arm.servo:
-                raise fail(K.SERVO_ERROR, f"the servo was turned off: motion {lost[0]} of the "
-                                          "program was discarded")
-            raise fail(K.ROBOT_ERROR, f"a stop discarded motion {lost[0]} of the program")
+        if not lost:
+            return None
+        self.abnormal = STATUS_DISCARDED
+        if not arm.servo:
+            return K.SERVO_ERROR, f"the servo was turned off: motion {lost[0]} of the program " \
+                                  "was discarded"
+        return K.ROBOT_ERROR, f"a stop discarded motion {lost[0]} of the program"
 
     def motion_status(self) -> int:
         """$DONE: 0 over, 1 the robot moves, 2 only the hand moves, 3 both, < 0 abnormal end."""
@@ -302,10 +310,10 @@ class RobotHost(Host):
     def wait_motions(self, vm) -> None:
         """After the program's end: wait until its motions are over (exceptions as `check`)."""
         self.state = "finishing motions"
+        self.check(vm)
         while self.pending:
+            self.sleep(POLL)
             self.check(vm)
-            if self.pending:
-                self.sleep(POLL)
 
     # === helpers ==================================================================================
     @property
@@ -756,7 +764,12 @@ class RobotHost(Host):
         return vm.timed_wait(proc, seconds, POLL)
 
     def done(self, vm, proc) -> None:
-        _push_flag(proc, self.motion_status())
+        """$DONE; while something moves it lets one control cycle pass (a program that polls
+        $DONE in a loop does not keep the processor from the simulation)."""
+        status = self.motion_status()
+        if status > 0:
+            self.sleep(0.0)
+        _push_flag(proc, status)
 
     # === ED1E–ED23: hands ========================================================================
     def _hand(self) -> Hand:

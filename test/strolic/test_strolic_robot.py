@@ -4,7 +4,6 @@ points without stopping, $WAIT and DELAY timing, PAUSE, motion errors and cancel
 that stop the arm."""
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pytest
@@ -227,3 +226,17 @@ def test_status_port_and_outputs(arm, executor):  # noqa: F811
     result = run(arm, executor, "16 DIN 3 5 DOUT 3 DIN 16 1 DOUT")
     assert result.stack == ["I2:17", "I2:5"]                 # servo on, hand closed
     assert any("output port 16 does not exist" in line for line in result.console)
+
+
+def test_done_sees_the_abnormal_end_and_the_program_still_stops(arm, executor):  # noqa: F811
+    seen = []
+
+    def hook():
+        if not seen and executor.world.time > 0.5:
+            seen.append(arm.stop())
+    result = run(arm, executor, ".name poll %1000 VAR #poll DCL "
+                                "#poll FDEF Fn{ top: $DONE DUP 0 GT >top BRT END } "
+                                "80 JSPEED DROP Ar[R8 0 40 0 0 0 0 0] IDRIVE DROP poll",
+                 hook=hook)
+    assert seen and result.status is Status.EXCEPTION and result.error.kind is K.ROBOT_ERROR
+    assert result.stack[-1] == "I2:-1"                        # $DONE gave the abnormal end
