@@ -307,10 +307,12 @@ class VehicleCore:
 
     @command
     def set_velocity(self, vel: Any) -> None:
-        """Within the unit's limits, > 0. Taken by every motion planned from now on."""
+        """Within the unit's limits, > 0. A moving base changes speed smoothly (at the
+        acceleration setting) to match; queued moves take it too. Jogs keep their velocities."""
         c = self.config
         self.velocity = positive_pair(vel, (c.velocity_limit_translation, c.velocity_limit_rotation),
                                       "vel", ("mm/s", "degree/s"))
+        self._retime()
 
     @command
     def set_acceleration(self, accel: Any) -> None:
@@ -323,6 +325,7 @@ class VehicleCore:
             raise VehicleRefused(AlarmCode.WRONG_STATE,
                                  f"the base is {STATE_STRINGS[s]}: set_acceleration is refused while moving")
         self.acceleration = value
+        self._retime()
 
     @command
     def set_jog_timeout(self, timeout: int) -> None:
@@ -600,6 +603,19 @@ class VehicleCore:
     def _accepted_motion(self) -> None:
         self.stuck = False
         self.alarms.clear(Kind.STUCK)
+
+    def _retime(self) -> None:
+        """Apply new settings to the running motion (from now on) and to the queued ones."""
+        limits = self._limits()
+
+        def retime(device: Device) -> None:
+            cur = device.current
+            if cur is not None and not device.stopping and hasattr(cur.motion, "retime"):
+                cur.motion.retime(device.t, limits)
+            for queued in device.queue:
+                if hasattr(queued.motion, "retime"):
+                    queued.motion.retime(0.0, limits)
+        self.device.edit(retime)
 
     def _reference_twist(self) -> tuple[float, float]:
         cur = self.device.current

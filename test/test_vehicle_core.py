@@ -141,3 +141,38 @@ def test_servo_off_while_moving_stops_first(base, executor):  # noqa: F811
     settle(executor, base, 2.0)
     steps(executor, 0.5)
     assert abs(base.odometry.v) < 1e-3
+
+
+def speeds_until_done(executor, base, seconds=30.0):  # noqa: F811
+    speeds = []
+    run_until(executor, lambda: speeds.append(base.odometry.v) or not base.device.busy, seconds)
+    return speeds
+
+
+@pytest.mark.parametrize("before, after", [(300.0, 600.0), (600.0, 200.0)])
+def test_set_velocity_while_moving_changes_speed_smoothly(base, executor, before, after):  # noqa: F811
+    ready(base)
+    base.set_velocity((before, 45.0))
+    base.move_forward(3000.0)
+    assert base.move_linear_abs((1500.0, 0.0, 0.0)).ok              # queued: takes it too
+    steps(executor, 2.0)
+    assert base.odometry.v == pytest.approx(before / 1000.0, abs=0.01)
+    assert base.set_velocity((after, 45.0)).ok
+    speeds = speeds_until_done(executor, base)
+    assert speeds[int(2.0 / executor.dt)] == pytest.approx(after / 1000.0, abs=0.01)
+    accel = max(abs(b - a) for a, b in zip(speeds, speeds[1:])) / executor.dt
+    assert accel < 0.5 * 1.3                                       # the acceleration setting
+    assert min(speeds) == pytest.approx(-after / 1000.0, abs=0.01)  # the queued move
+    assert_at(base, 1500.0, 0.0, 0.0)
+
+
+def test_set_velocity_while_turning(base, executor):  # noqa: F811
+    ready(base)
+    base.move_turn(180.0)
+    steps(executor, 1.5)
+    assert math.degrees(base.odometry.w) == pytest.approx(45.0, abs=1.0)
+    base.set_velocity((300.0, 20.0))
+    steps(executor, 1.0)
+    assert math.degrees(base.odometry.w) == pytest.approx(20.0, abs=1.0)
+    settle(executor, base)
+    assert_at(base, 0.0, 0.0, 180.0)
