@@ -186,8 +186,8 @@ class VehicleCore:
             return VehicleState.POWERED
         if self.stuck:
             return VehicleState.STUCK
-        if self.device.paused:
-            return VehicleState.PAUSED
+        if self.device.paused:        # Paused once at rest; Busy while it decelerates
+            return VehicleState.BUSY if self.device.moving and self.device.rate > 0.0 else VehicleState.PAUSED
         if self.device.busy:
             return VehicleState.BUSY
         if self._latest_warning() is not None:

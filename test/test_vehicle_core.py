@@ -102,8 +102,9 @@ def test_pause_keeps_the_queue_and_accepts_new_motions_resume_runs_them(base, ex
     ready(base)
     base.move_forward(600.0)
     steps(executor, 1.0)
-    assert base.pause().ok and state(base) == VehicleState.PAUSED
+    assert base.pause().ok and state(base) == VehicleState.BUSY        # decelerating
     steps(executor, 1.0)
+    assert state(base) == VehicleState.PAUSED
     held = position(base)
     steps(executor, 1.0)
     assert position(base) == pytest.approx(held, abs=0.5)          # at rest
