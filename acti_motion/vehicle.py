@@ -595,6 +595,8 @@ class VehicleCore:
                                      "idle base (wait, or call stop)")
             return None
         motion_id = self.device.edit(update)
+        if motion_id is None and target == (0.0, 0.0):
+            return {"motion_id": 0}                  # standing still already: nothing to queue
         if motion_id is None:
             return self._submit(plan, label)
         self._accepted_motion()

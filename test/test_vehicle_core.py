@@ -74,6 +74,13 @@ def test_move_circular_rel_about_a_point_on_the_axle(base, executor, centre_y, a
     assert max(abs(v) for v in speeds) <= base.velocity[0] / 1000.0 * 1.05
 
 
+def test_circular_rel_about_the_centre_of_the_axle_turns_in_place(base, executor):  # noqa: F811
+    ready(base)
+    assert base.move_circular_rel((0.0, 0.0), -45.0).ok
+    settle(executor, base)
+    assert_at(base, 0.0, 0.0, -45.0)
+
+
 def test_circular_rel_off_the_axle_is_refused(base):
     ready(base)
     r = base.move_circular_rel((100.0, 500.0), 90.0)
