@@ -167,8 +167,19 @@ class VehicleCore:
         self.digital_sensor_lock = False
         self._contact_armed = True
         self._stuck_since: float | None = None
-        self.velocity = (c.default_velocity_translation, c.default_velocity_rotation)
-        self.acceleration = (c.default_accel_translation, c.default_accel_rotation)
+        try:                          # the start-up settings obey the rules of the setters
+            self.velocity = positive_pair(
+                (c.default_velocity_translation, c.default_velocity_rotation),
+                (c.velocity_limit_translation, c.velocity_limit_rotation), "default velocity",
+                ("mm/s", "degree/s"))
+            self.acceleration = positive_pair(
+                (c.default_accel_translation, c.default_accel_rotation),
+                (c.accel_limit_translation, c.accel_limit_rotation), "default acceleration",
+                ("mm/s²", "degree/s²"))
+        except Refused as r:
+            raise ValueError(f"vehicle configuration: {r.comment}") from None
+        if c.jog_timeout <= 0:
+            raise ValueError(f"vehicle configuration: jog_timeout is {c.jog_timeout} ms, it must be > 0")
         self.jog_timeout = c.jog_timeout
         self.joystick = False
         self._dt = executor.dt

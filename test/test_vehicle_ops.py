@@ -352,3 +352,10 @@ def test_pause_reports_busy_until_the_base_is_at_rest(base, executor):  # noqa: 
     took = run_until(executor, lambda: state(base) == VehicleState.PAUSED, 2.0)
     assert took == pytest.approx(0.8 / 1.0, abs=0.05)        # 800 mm/s at 1000 mm/s²
     assert abs(base.odometry.v) < 0.02
+
+
+@pytest.mark.parametrize("config", [dict(default_velocity_translation=2000.0),
+                                    dict(default_accel_rotation=0.0), dict(jog_timeout=0)])
+def test_start_up_settings_outside_the_limits_are_rejected(executor, config):  # noqa: F811
+    with pytest.raises(ValueError, match="vehicle configuration"):
+        VehicleCore(executor, VehicleConfig(**config))
