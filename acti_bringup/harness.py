@@ -60,10 +60,10 @@ class RosClient:
     def call(self, srv_type: type, name: str, **fields: Any) -> Any:
         client = self._clients.get(name)
         if client is None:
-            client = self.node.create_client(srv_type, name)
-            if not client.wait_for_service(timeout_sec=SERVICE_TIMEOUT):
-                raise TimeoutError(f"service {name} did not appear")
-            self._clients[name] = client
+            client = self._clients[name] = self.node.create_client(srv_type, name)
+        # also after the server's process was restarted (the next test module's node)
+        if not client.service_is_ready() and not client.wait_for_service(timeout_sec=SERVICE_TIMEOUT):
+            raise TimeoutError(f"service {name} did not appear")
         future = client.call_async(srv_type.Request(**fields))
         self.executor.spin_until_future_complete(future, timeout_sec=CALL_TIMEOUT)
         if not future.done():

@@ -1,19 +1,38 @@
 """The manipulator core: the ACT common port and the middle-level motion port, without ROS.
 
-Each public method is one IDL operation, named as the ROS service (snake case), taking the IDL
-parameters by their snake-case names and returning a `Reply`. Units are the spec's: degree, %, s.
+Each public operation is one IDL operation, named as the ROS service (snake case), taking the IDL
+parameters by their snake-case names and returning a `Reply` whose id is one the spec lists for
+that operation (`@returns`). Units are the spec's: mm, degree, mm/s, degree/s, s, %.
+
+Frames: the arm frame is `base_link`; the robot frame is the arm frame moved by the base offset
+(setBaseOffset gives the robot frame seen from the arm frame); the control point is the flange
+moved by the control-point offset. Every Cartesian value of the ports is the control point in
+the robot frame. `elbow` is the arm angle in degrees (see `acti_motion.kinematics`);
+`struct_flag` reports the posture's branch (bits 0x1 θ2 < 0, 0x2 θ4 > 0, 0x4 θ6 < 0) and is
+ignored on input: moves take the branch nearest to where they start.
 """
 from __future__ import annotations
 
+import math
+import threading
 from dataclasses import dataclass
+from enum import IntEnum
+from functools import lru_cache
+from typing import Any, Callable
 
 import numpy as np
 
 from acti_motion.executor import MotionExecutor
+from acti_motion.kinematics import ArmKinematics, Unreachable, rotate_about
+from acti_motion.poses import (Frames, compose_relative, hg_to_pose, pose_to_hg)
 from acti_motion.profiles import Trapezoid
-from acti_motion.replies import (Refused, Reply, ReturnCode, answers, finite_vector,
-                                 ratio_percent)
-from acti_sim.world import ARM_JOINTS, World
+from acti_motion.replies import (Refused, Reply, ReturnCode, finite_number, finite_vector,
+                                 ratio_percent, returns, value_error)
+from acti_motion.trajectories import (ArcPath, ArmMotion, ArmSetpoint, CartesianLimits,
+                                      CartesianPlanner, LinearJointPath, LinePath, load_toppra)
+from acti_sim.world import GRIPPER_JOINTS
+
+__all__ = ["ArmConfig", "ArmCore", "ArmSetpoint", "Alarm", "AlarmType"]
 
 STATE_SERVO_ON = 0x01
 STATE_MOVING = 0x02
@@ -21,106 +40,463 @@ STATE_ALARM = 0x04
 STATE_BUFFER_FULL = 0x08
 STATE_PAUSED = 0x10
 
+ALARM_JOINT_SOFT_LIMIT = 0x4
+ALARM_CARTESIAN_SOFT_LIMIT = 0x5
 
-@dataclass
-class ArmConfig:
-    """Start-up settings of the arm (the node's parameters)."""
-    queue_size: int = 32
-    initial_speed_ratio: int = 0
-    accel_time_joint: float = 0.3
-    min_accel_time_joint: float = 0.1
-    initial_joints_deg: tuple[float, ...] = (0.0, 30.0, 0.0, -60.0, 0.0, 60.0, 0.0)
+R = ReturnCode
+# The ids the spec lists per kind of operation (OK and NG always; see `returns`).
+GETTER: tuple[ReturnCode, ...] = ()
+CONTROL: tuple[ReturnCode, ...] = ()
+SETTER = (R.VALUE_ERR,)
+MOVE = (R.STATUS_ERR, R.VALUE_ERR, R.FULL_MOTION_QUEUE_ERR, R.NOT_SV_ON_ERR)
+
+CARTESIAN_WATCH_TOLERANCE_MM = 0.1
+REL_ELBOW_CLEARANCE = math.sin(math.radians(10.0))
+JOINT_WATCH_TOLERANCE_DEG = 1e-6
+
+
+class AlarmType(IntEnum):
+    FAULT = 0
+    WARNING = 1
+    UNKNOWN = 2
 
 
 @dataclass(frozen=True)
-class ArmSetpoint:
-    """What the arm is commanded to hold: joints (rad) and the finger position (m)."""
-    joints: np.ndarray
-    finger: float
+class Alarm:
+    code: int
+    type: AlarmType
+    description: str
+
+    def as_tuple(self) -> tuple[int, int, str]:
+        return (self.code, int(self.type), self.description)
 
 
-class JointMotion:
-    """Joint-space straight line with one synchronized trapezoid (PTP)."""
+@dataclass
+class ArmConfig:
+    """Start-up settings of the arm (the node's parameters); units as on the services."""
+    queue_size: int = 32
+    initial_speed_ratio: int = 0                  # % for both setSpeedJoint and setSpeedCartesian
+    accel_time_joint: float = 0.3                 # s
+    min_accel_time_joint: float = 0.1             # s
+    accel_time_cartesian: float = 0.3             # s
+    min_accel_time_cartesian: float = 0.1         # s
+    max_speed_translation: float = 500.0          # mm/s
+    max_speed_rotation: float = 90.0              # degree/s (orientation and elbow)
+    gripper_speed: float = 100.0                  # mm/s of the opening (both fingers)
+    # x lower, x upper, y lower, y upper, z lower, z upper of the control point [mm]
+    soft_limit_cartesian: tuple[float, ...] = (-1000.0, 1200.0, -1000.0, 1000.0, -100.0, 1600.0)
+    initial_joints_deg: tuple[float, ...] = (0.0, 30.0, 0.0, -60.0, 0.0, 60.0, 0.0)
+    home_joints_deg: tuple[float, ...] = (0.0, 30.0, 0.0, -60.0, 0.0, 60.0, 0.0)
 
-    def __init__(self, start: ArmSetpoint, goal: np.ndarray, profile: Trapezoid) -> None:
-        self.start, self.goal, self.profile = start, goal, profile
-        self.duration = profile.duration
-        self._delta = goal - start.joints
 
-    def at(self, t: float) -> ArmSetpoint:
-        s, _ = self.profile.sample(t)
-        return ArmSetpoint(self.start.joints + s * self._delta, self.start.finger)
+@lru_cache(maxsize=1)
+def shared_kinematics() -> ArmKinematics:
+    return ArmKinematics()
 
-    def apply(self, world: World, t: float, rate: float) -> None:
-        s, ds = self.profile.sample(t)
-        world.set_arm_targets(self.start.joints + s * self._delta, rate * ds * self._delta)
+
+def _ignored(why: str) -> Reply:
+    return Reply(ReturnCode.OK, f"ignored: {why}")
+
+
+def _first_exit(values: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+                tol: float) -> tuple[int, int] | None:
+    """(sample, axis) where rows of `values` first go from inside [lower, upper] to outside,
+    or where the last row is outside; None when the path stays (or ends) inside."""
+    inside = (values >= lower - tol) & (values <= upper + tol)
+    exits = np.argwhere(inside[:-1] & ~inside[1:])
+    if len(exits):
+        k, axis = exits[0]
+        return int(k) + 1, int(axis)
+    outside = np.flatnonzero(~inside[-1])
+    if len(outside):
+        return len(values) - 1, int(outside[0])
+    return None
 
 
 class ArmCore:
     """State, settings and motion queue of the 7-axis arm with its 1-axis gripper."""
 
     def __init__(self, executor: MotionExecutor, config: ArmConfig | None = None) -> None:
-        self.config = config or ArmConfig()
+        self.config = c = config or ArmConfig()
         self.executor = executor
+        self.kin = shared_kinematics()
+        self.planner = CartesianPlanner(self.kin)
         world = executor.world
-        world.reset_arm(np.radians(self.config.initial_joints_deg))
-        limits = [world.limits[n] for n in ARM_JOINTS]
-        self.axis_count = len(ARM_JOINTS)
-        self.max_speed_joint = np.degrees([lim.velocity for lim in limits])
-        self.soft_limit_joint = np.degrees([[lim.lower, lim.upper] for lim in limits])
-        self.speed_joint = ratio_percent(self.config.initial_speed_ratio, "initial_speed_ratio")
-        self.accel_time_joint = self.config.accel_time_joint
+        self.axis_count = 7
+        self.hard_limit_joint = np.degrees(np.stack([self.kin.lower, self.kin.upper], axis=1))
+        self.hard_max_speed_joint = np.degrees(self.kin.velocity)
+        q0 = self._start_joints(c.initial_joints_deg, "initial_joints_deg")
+        self._start_joints(c.home_joints_deg, "home_joints_deg")
+        self.home = np.array(c.home_joints_deg, float)
+        world.reset_arm(q0)
+        self.finger_max = world.limits[GRIPPER_JOINTS[0]].upper
+        # settings (units of the ports)
+        self.max_speed_joint = self.hard_max_speed_joint.copy()
+        self.soft_limit_joint = self.hard_limit_joint.copy()          # rows: [lower, upper]
+        self.soft_limit_cartesian = np.array(c.soft_limit_cartesian, float).reshape(3, 2)
+        self.speed_joint = ratio_percent(c.initial_speed_ratio, "initial_speed_ratio")
+        self.speed_cartesian = self.speed_joint
+        self.min_accel_time_joint = c.min_accel_time_joint
+        self.accel_time_joint = max(c.accel_time_joint, c.min_accel_time_joint)
+        self.min_accel_time_cartesian = c.min_accel_time_cartesian
+        self.accel_time_cartesian = max(c.accel_time_cartesian, c.min_accel_time_cartesian)
+        self.max_speed_cartesian = (float(c.max_speed_translation), float(c.max_speed_rotation))
+        self.frames = Frames()
         self.servo = False
-        self.alarms: list = []
+        self._alarms: list[Alarm] = []
+        self._alarm_lock = threading.Lock()
         self._feedback = world.arm_positions()
         self._finger = world.gripper_position()
-        self.device = executor.add_device("arm", self.config.queue_size,
-                                          ArmSetpoint(self._feedback.copy(), self._finger))
+        self.device = executor.add_device("arm", c.queue_size,
+                                          ArmSetpoint(q0.copy(), self._finger))
+        self._inside: np.ndarray | None = None
         executor.after_step(self._sample)
+        threading.Thread(target=load_toppra, name="toppra-import", daemon=True).start()
 
-    # --- the simulation thread's snapshot ----------------------------------------------------
-    def _sample(self, world: World) -> None:
+    def _start_joints(self, values: tuple[float, ...], name: str) -> np.ndarray:
+        q = np.asarray(values, float)
+        lo, hi = self.hard_limit_joint[:, 0], self.hard_limit_joint[:, 1]
+        if q.shape != (self.axis_count,) or not np.all(np.isfinite(q)) \
+                or np.any(q < lo) or np.any(q > hi):
+            raise ValueError(f"{name} must be {self.axis_count} finite joint values within "
+                             f"the joint limits, got {values}")
+        return np.radians(q)
+
+    # === the simulation thread: snapshot and soft-limit watch ===================================
+    def _sample(self, world) -> None:
         self._feedback = world.arm_positions()
         self._finger = world.gripper_position()
+        self._watch()
 
-    # --- common port -------------------------------------------------------------------------
-    @answers
+    def _watch(self) -> None:
+        """Stop and raise an alarm when the commanded set-point leaves a soft limit while moving
+        (possible when the limits changed after the motion was accepted)."""
+        d = self.device
+        cur = d.current
+        q = cur.motion.at(d.t).joints if cur is not None else d.hold.joints
+        qd = np.degrees(q)
+        p = self.frames.tool_of(self.kin.flange(q))[:3, 3] * 1000.0
+        values = np.concatenate([qd, p])
+        lj, lc = self.soft_limit_joint, self.soft_limit_cartesian
+        lower = np.concatenate([lj[:, 0] - JOINT_WATCH_TOLERANCE_DEG,
+                                lc[:, 0] - CARTESIAN_WATCH_TOLERANCE_MM])
+        upper = np.concatenate([lj[:, 1] + JOINT_WATCH_TOLERANCE_DEG,
+                                lc[:, 1] + CARTESIAN_WATCH_TOLERANCE_MM])
+        inside = (values >= lower) & (values <= upper)
+        was, self._inside = self._inside, inside
+        if cur is None or was is None or self._alarms:
+            return
+        left = np.flatnonzero(was & ~inside)
+        if not len(left):
+            return
+        i = int(left[0])
+        if i < self.axis_count:
+            alarm = Alarm(ALARM_JOINT_SOFT_LIMIT, AlarmType.WARNING,
+                          f"joint soft limit exceeded while moving: J{i + 1} = {values[i]:.3f}° "
+                          f"left [{lj[i, 0]:g}, {lj[i, 1]:g}]°")
+        else:
+            axis = "xyz"[i - self.axis_count]
+            lim = lc[i - self.axis_count]
+            alarm = Alarm(ALARM_CARTESIAN_SOFT_LIMIT, AlarmType.WARNING,
+                          f"Cartesian soft limit exceeded while moving: {axis} = {values[i]:.2f} mm "
+                          f"left [{lim[0]:g}, {lim[1]:g}] mm")
+        with self._alarm_lock:
+            self._alarms.append(alarm)
+        self._stop_motion(fastest=True)
+
+    # === common port ============================================================================
+    @returns(R.STATUS_ERR)
     def servo_on(self) -> None:
         self.servo = True
 
-    @answers
+    @returns()
     def servo_off(self) -> None:
         """All axes off; a moving arm stops first (the brakes then hold it where it stopped)."""
         self._stop_motion()
         self.servo = False
 
-    @answers
+    @returns(*GETTER)
     def get_state(self) -> dict:
         return {"state": self.state_word()}
 
-    @answers
+    @returns(*GETTER)
     def get_feedback_pos_joint(self) -> dict:
         """Measured J1 … J7 (degree), then the gripper axis as its opening (mm)."""
         opening_mm = 2000.0 * self._finger
         return {"pos": [*np.degrees(self._feedback), opening_mm]}
 
-    # --- middle-level motion port --------------------------------------------------------------
-    @answers
+    @returns(*GETTER)
+    def get_manip_info(self) -> dict:
+        cycle_ms = round(self.executor.dt * 1000.0)
+        return {"manip_info": ("acti_ros2", "7-axis SRS arm with 1-axis gripper (PyBullet)",
+                               self.axis_count, cycle_ms, True)}
+
+    @returns(*GETTER)
+    def get_active_alarm(self) -> dict:
+        with self._alarm_lock:
+            return {"alarms": [a.as_tuple() for a in self._alarms]}
+
+    @returns(*CONTROL)
+    def clear_alarms(self) -> Reply:
+        with self._alarm_lock:
+            n = len(self._alarms)
+            self._alarms.clear()
+        return Reply(comment=f"cleared {n} alarm(s)" if n else "no alarm was active")
+
+    @returns(*GETTER)
+    def get_soft_limit_joint(self) -> dict:
+        return {"soft_limit": [(float(hi), float(lo)) for lo, hi in self.soft_limit_joint]}
+
+    @returns(R.STATUS_ERR, R.VALUE_ERR)
+    def set_soft_limit_joint(self, soft_limit: list) -> None:
+        self._check_idle("set_soft_limit_joint")
+        if len(soft_limit) != self.axis_count:
+            raise value_error(f"soft_limit needs {self.axis_count} limits (J1 … J{self.axis_count}),"
+                              f" got {len(soft_limit)}")
+        limits = np.empty((self.axis_count, 2))
+        for i, lim in enumerate(soft_limit):
+            upper, lower = self._limit_value(lim, f"soft_limit[{i}] (J{i + 1})")
+            hlo, hhi = self.hard_limit_joint[i]
+            if lower < hlo - 1e-9 or upper > hhi + 1e-9:
+                raise value_error(f"soft_limit[{i}]: [{lower:g}, {upper:g}]° is outside J{i + 1}'s "
+                                  f"hardware range [{hlo:.3f}, {hhi:.3f}]°")
+            limits[i] = lower, upper
+        self.soft_limit_joint = limits
+
+    # === middle-level port: getters ==============================================================
+    @returns(*GETTER)
+    def get_feedback_pos_cartesian(self) -> dict:
+        return {"pos": self.car_pos_with_elbow(self._feedback)}
+
+    @returns(*GETTER)
+    def get_base_offset(self) -> dict:
+        return {"offset": pose_to_hg(self.frames.base)}
+
+    @returns(*GETTER)
+    def get_max_speed_cartesian(self) -> dict:
+        return {"speed": self.max_speed_cartesian}
+
+    @returns(*GETTER)
+    def get_max_speed_joint(self) -> dict:
+        return {"speed": [float(v) for v in self.max_speed_joint]}
+
+    @returns(*GETTER)
+    def get_min_accel_time_cartesian(self) -> dict:
+        return {"acl_time": self.min_accel_time_cartesian}
+
+    @returns(*GETTER)
+    def get_min_accel_time_joint(self) -> dict:
+        return {"acl_time": self.min_accel_time_joint}
+
+    @returns(*GETTER)
+    def get_soft_limit_cartesian(self) -> dict:
+        return {f"{a}_limit": (float(hi), float(lo))
+                for a, (lo, hi) in zip("xyz", self.soft_limit_cartesian)}
+
+    @returns(*GETTER)
+    def get_home(self) -> dict:
+        return {"joint_point": [float(v) for v in self.home]}
+
+    # === middle-level port: settings ==============================================================
+    @returns(*SETTER)
     def set_speed_joint(self, spd_ratio: int) -> None:
         self.speed_joint = ratio_percent(spd_ratio, "spd_ratio")
 
-    @answers
-    def move_ptp_joint_abs(self, joint_points: list[float]) -> dict:
-        goal = finite_vector(joint_points, self.axis_count, "joint_points")
-        return self._queue_joint_move(goal, "move_ptp_joint_abs")
+    @returns(*SETTER)
+    def set_speed_cartesian(self, spd_ratio: int) -> None:
+        self.speed_cartesian = ratio_percent(spd_ratio, "spd_ratio")
 
-    # --- shared checks and queueing ------------------------------------------------------------
+    @returns(*SETTER)
+    def set_accel_time_joint(self, acl_time: float) -> None:
+        self.accel_time_joint = self._accel_time(acl_time, self.min_accel_time_joint,
+                                                 "set_min_accel_time_joint")
+
+    @returns(*SETTER)
+    def set_accel_time_cartesian(self, acl_time: float) -> None:
+        self.accel_time_cartesian = self._accel_time(acl_time, self.min_accel_time_cartesian,
+                                                     "set_min_accel_time_cartesian")
+
+    @returns(*SETTER)
+    def set_min_accel_time_joint(self, acl_time: float) -> Reply:
+        self.min_accel_time_joint = self._min_accel_time(acl_time)
+        if self.accel_time_joint < self.min_accel_time_joint:
+            self.accel_time_joint = self.min_accel_time_joint
+            return Reply(comment=f"the joint accel time was below it and is now {acl_time:g} s")
+        return Reply()
+
+    @returns(*SETTER)
+    def set_min_accel_time_cartesian(self, acl_time: float) -> Reply:
+        self.min_accel_time_cartesian = self._min_accel_time(acl_time)
+        if self.accel_time_cartesian < self.min_accel_time_cartesian:
+            self.accel_time_cartesian = self.min_accel_time_cartesian
+            return Reply(comment=f"the Cartesian accel time was below it and is now {acl_time:g} s")
+        return Reply()
+
+    @returns(*SETTER)
+    def set_max_speed_joint(self, speed: list[float]) -> None:
+        v = finite_vector(speed, self.axis_count, "speed")
+        for i, (x, hw) in enumerate(zip(v, self.hard_max_speed_joint)):
+            if not 0.0 < x <= hw + 1e-9:
+                raise value_error(f"speed[{i}] (J{i + 1}) is {x:g}°/s: it must be > 0 and at most "
+                                  f"the joint's rated {hw:.3f}°/s")
+        self.max_speed_joint = v
+
+    @returns(*SETTER)
+    def set_max_speed_cartesian(self, speed: tuple) -> None:
+        translation = finite_number(speed[0], "speed.translation")
+        rotation = finite_number(speed[1], "speed.rotation")
+        if translation <= 0 or rotation <= 0:
+            raise value_error(f"speed must be > 0 (translation {translation:g} mm/s, "
+                              f"rotation {rotation:g}°/s)")
+        self.max_speed_cartesian = (translation, rotation)
+
+    @returns(*SETTER)
+    def set_soft_limit_cartesian(self, x_limit: tuple, y_limit: tuple, z_limit: tuple) -> None:
+        limits = np.empty((3, 2))
+        for i, (axis, lim) in enumerate(zip("xyz", (x_limit, y_limit, z_limit))):
+            upper, lower = self._limit_value(lim, f"{axis}_limit")
+            limits[i] = lower, upper
+        self.soft_limit_cartesian = limits
+
+    @returns(*SETTER)
+    def set_base_offset(self, offset: list[float]) -> None:
+        self.frames = Frames(hg_to_pose(offset, "offset"), self.frames.tool)
+
+    @returns(R.STATUS_ERR)
+    def set_control_point_offset(self, offset: list[float]) -> None:
+        self._check_idle("set_control_point_offset")
+        tool = hg_to_pose(offset, "offset", code=ReturnCode.NG)
+        self.frames = Frames(self.frames.base, tool)
+
+    @returns(*SETTER)
+    def set_home(self, joint_point: list[float]) -> None:
+        q = finite_vector(joint_point, self.axis_count, "joint_point")
+        self._check_joint_target(q, "joint_point")
+        self.home = q
+
+    # === middle-level port: motion control ======================================================
+    @returns(*CONTROL)
+    def pause(self) -> Reply | None:
+        why = self._control_ignored()
+        if why is None and self.device.paused:
+            why = "already paused"
+        if why is None and self.device.current is None:
+            why = "the arm is not moving"
+        if why is not None:
+            return _ignored(why)
+        if not self.device.pause(self._current_ramp()):
+            return _ignored("already paused")
+        return None
+
+    @returns(*CONTROL)
+    def resume(self) -> Reply | None:
+        if not self.device.paused:
+            return _ignored("the arm is not paused")
+        if not self.device.resume(self._current_ramp()):
+            return _ignored("a stop is in progress")
+        return None
+
+    @returns(*CONTROL)
+    def stop(self) -> Reply | None:
+        why = self._control_ignored()
+        if why is not None:
+            return _ignored(why)
+        self._stop_motion()
+        return None
+
+    # === middle-level port: moves =================================================================
+    @returns(*MOVE)
+    def move_ptp_joint_abs(self, joint_points: list[float]) -> dict:
+        self._check_can_move(self.speed_joint, "set_speed_joint")
+        goal = np.radians(finite_vector(joint_points, self.axis_count, "joint_points"))
+        return self._queue_joint_move(lambda start: goal, "move_ptp_joint_abs")
+
+    @returns(*MOVE)
+    def move_ptp_joint_rel(self, joint_points: list[float]) -> dict:
+        self._check_can_move(self.speed_joint, "set_speed_joint")
+        delta = np.radians(finite_vector(joint_points, self.axis_count, "joint_points"))
+        return self._queue_joint_move(lambda start: start.joints + delta, "move_ptp_joint_rel")
+
+    @returns(*MOVE)
+    def go_home(self) -> dict:
+        self._check_can_move(self.speed_joint, "set_speed_joint")
+        goal = np.radians(self.home)
+        return self._queue_joint_move(lambda start: goal, "go_home")
+
+    @returns(*MOVE)
+    def move_ptp_cartesian_abs(self, car_point: tuple) -> dict:
+        self._check_can_move(self.speed_joint, "set_speed_joint")
+        target, psi = self._car_point(car_point, "car_point")
+        return self._queue_ptp_cartesian(lambda P0: target, "move_ptp_cartesian_abs", psi=psi)
+
+    @returns(*MOVE)
+    def move_ptp_cartesian_rel(self, car_point: tuple) -> dict:
+        self._check_can_move(self.speed_joint, "set_speed_joint")
+        delta, turn = self._car_point(car_point, "car_point")
+        return self._queue_ptp_cartesian(lambda P0: compose_relative(P0, delta),
+                                         "move_ptp_cartesian_rel", turn=turn)
+
+    @returns(*MOVE)
+    def move_linear_cartesian_abs(self, car_point: tuple) -> dict:
+        self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
+        target, psi = self._car_point(car_point, "car_point")
+        return self._queue_cartesian(lambda P0: LinePath(P0, target), "move_linear_cartesian_abs",
+                                     psi=psi)
+
+    @returns(*MOVE)
+    def move_linear_cartesian_rel(self, car_point: tuple) -> dict:
+        self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
+        delta, turn = self._car_point(car_point, "car_point")
+        return self._queue_cartesian(lambda P0: LinePath(P0, compose_relative(P0, delta)),
+                                     "move_linear_cartesian_rel", turn=turn)
+
+    @returns(*MOVE)
+    def move_circular_cartesian_abs(self, car_point_r: tuple, car_point_t: tuple) -> dict:
+        """2014 revision: arc from where the previous motion ends, through R's position, to T
+        (R's orientation and elbow are not used)."""
+        self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
+        via, _ = self._car_point(car_point_r, "car_point_r")
+        target, psi = self._car_point(car_point_t, "car_point_t")
+        return self._queue_cartesian(lambda P0: ArcPath(P0, via[:3, 3], target),
+                                     "move_circular_cartesian_abs", psi=psi)
+
+    @returns(*MOVE)
+    def move_circular_cartesian_rel(self, car_point_r: tuple, car_point_t: tuple) -> dict:
+        self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
+        via, _ = self._car_point(car_point_r, "car_point_r")
+        delta, turn = self._car_point(car_point_t, "car_point_t")
+        return self._queue_cartesian(
+            lambda P0: ArcPath(P0, P0[:3, 3] + via[:3, 3], compose_relative(P0, delta)),
+            "move_circular_cartesian_rel", turn=turn)
+
+    # --- gripper -----------------------------------------------------------------------------------
+    @returns(R.STATUS_ERR, R.VALUE_ERR, R.FULL_MOTION_QUEUE_ERR, R.NOT_SV_ON_ERR)
+    def open_gripper(self) -> dict:
+        return self._queue_gripper(100, "open_gripper")
+
+    @returns(R.STATUS_ERR, R.FULL_MOTION_QUEUE_ERR, R.NOT_SV_ON_ERR)
+    def close_gripper(self) -> dict:
+        return self._queue_gripper(0, "close_gripper")
+
+    @returns(R.STATUS_ERR, R.VALUE_ERR, R.NOT_SV_ON_ERR)
+    def move_gripper(self, angle_ratio: int) -> dict:
+        """The spec lists no FULL_MOTION_QUEUE_ERR here: a full queue is STATUS_ERR."""
+        ratio = ratio_percent(angle_ratio, "angle_ratio")
+        try:
+            return self._queue_gripper(ratio, "move_gripper")
+        except Refused as r:
+            if r.code == R.FULL_MOTION_QUEUE_ERR:
+                raise Refused(R.STATUS_ERR, r.comment) from None
+            raise
+
+    # === state, feedback and progress (also for the node's topics and actions) =====================
     def state_word(self) -> int:
         d = self.device
         word = STATE_SERVO_ON if self.servo else 0
-        if d.busy and not (d.paused and d.rate <= 0.0):
+        if d.current is not None and not (d.paused and d.rate <= 0.0) \
+                or d.current is None and d.queue and not d.paused:
             word |= STATE_MOVING
-        if self.alarms:
+        if self._alarms:
             word |= STATE_ALARM
         if d.full:
             word |= STATE_BUFFER_FULL
@@ -128,39 +504,238 @@ class ArmCore:
             word |= STATE_PAUSED
         return word
 
-    def _check_can_move(self) -> None:
-        if not self.servo:
-            raise Refused(ReturnCode.NOT_SV_ON_ERR, "servo is off: call servo_on first")
-        if self.alarms:
-            raise Refused(ReturnCode.STATUS_ERR, "an alarm is active: call clear_alarms first")
+    @property
+    def alarms(self) -> list[Alarm]:
+        with self._alarm_lock:
+            return list(self._alarms)
 
-    def _check_joint_limits(self, goal_deg: np.ndarray, name: str) -> None:
+    def tool_pose(self, q: np.ndarray) -> np.ndarray:
+        """Control point in the robot frame (4×4, m) at joints q (rad)."""
+        return self.frames.tool_of(self.kin.flange(q))
+
+    def car_pos_with_elbow(self, q: np.ndarray) -> tuple[list[float], float, int]:
+        return (pose_to_hg(self.tool_pose(q)), math.degrees(self.kin.arm_angle(q)),
+                self.kin.flags(q))
+
+    @property
+    def feedback_joints(self) -> np.ndarray:
+        return self._feedback
+
+    def motion_status(self) -> tuple[int, str, float, int]:
+        """(current motion id or 0, its label, its completed fraction, queued motions)."""
+        cur = self.device.current
+        motion_id, fraction = self.device.progress()
+        label = cur.label if cur is not None and cur.id == motion_id else ""
+        return motion_id, label, fraction, self.device.queue_length
+
+    # === checks ======================================================================================
+    def _check_can_move(self, ratio: int | None = None, setter: str = "") -> None:
+        if not self.servo:
+            raise Refused(R.NOT_SV_ON_ERR, "servo is off: call servo_on first")
+        if self._alarms:
+            raise Refused(R.STATUS_ERR, "an alarm is active: see get_active_alarm, then call "
+                                        "clear_alarms")
+        if ratio is not None and ratio <= 0:
+            raise Refused(R.STATUS_ERR, f"the speed ratio is 0 %: set it with {setter} first")
+
+    def _check_idle(self, name: str) -> None:
+        """The spec refuses these while moving (state bit 0x02) or alarmed; paused is not moving."""
+        if self.state_word() & STATE_MOVING:
+            raise Refused(R.STATUS_ERR, f"{name} is refused while the arm moves "
+                                        "(wait, pause or stop first)")
+        if self._alarms:
+            raise Refused(R.STATUS_ERR, f"{name} is refused while an alarm is active")
+
+    def _control_ignored(self) -> str | None:
+        if not self.servo:
+            return "servo is off"
+        if self._alarms:
+            return "an alarm is active"
+        return None
+
+    @staticmethod
+    def _limit_value(lim: Any, name: str) -> tuple[float, float]:
+        """(upper, lower) of a LimitValue, finite and upper >= lower, else VALUE_ERR."""
+        if isinstance(lim, dict):
+            lim = (lim.get("upper"), lim.get("lower"))
+        if len(lim) != 2:
+            raise value_error(f"{name} needs upper and lower")
+        upper = finite_number(lim[0], f"{name}.upper")
+        lower = finite_number(lim[1], f"{name}.lower")
+        if upper < lower:
+            raise value_error(f"{name}: upper {upper:g} is below lower {lower:g}")
+        return upper, lower
+
+    def _accel_time(self, acl_time: float, minimum: float, setter: str) -> float:
+        t = finite_number(acl_time, "acl_time")
+        if t < minimum:
+            raise value_error(f"acl_time {t:g} s is below the minimum accel time {minimum:g} s "
+                              f"({setter} sets it)")
+        return t
+
+    def _min_accel_time(self, acl_time: float) -> float:
+        t = finite_number(acl_time, "acl_time")
+        floor = 2 * self.executor.dt
+        if t < floor:
+            raise value_error(f"acl_time {t:g} s is below two control cycles ({floor:.4f} s)")
+        return t
+
+    def _check_joint_target(self, goal_deg: np.ndarray, name: str) -> None:
         lo, hi = self.soft_limit_joint[:, 0], self.soft_limit_joint[:, 1]
         for i, (q, a, b) in enumerate(zip(goal_deg, lo, hi)):
-            if not a <= q <= b:
-                raise Refused(ReturnCode.VALUE_ERR,
-                              f"{name}: J{i + 1} = {q:g}° is outside the soft limit [{a:g}, {b:g}]°")
+            if not a - 1e-9 <= q <= b + 1e-9:
+                raise value_error(f"{name}: J{i + 1} = {q:g}° is outside the soft limit "
+                                  f"[{a:g}, {b:g}]°")
 
-    def _queue_joint_move(self, goal_deg: np.ndarray, label: str) -> dict:
-        self._check_can_move()
-        if self.speed_joint <= 0:
-            raise Refused(ReturnCode.STATUS_ERR,
-                          "the joint speed ratio is 0 %: set it with set_speed_joint first")
-        self._check_joint_limits(goal_deg, label)
-        goal = np.radians(goal_deg)
+    def _car_point(self, car_point: Any, name: str) -> tuple[np.ndarray, float]:
+        """(pose 4×4 m, elbow rad) of a CarPosWithElbow, else VALUE_ERR."""
+        if isinstance(car_point, dict):
+            car_point = (car_point.get("car_pos"), car_point.get("elbow"),
+                         car_point.get("struct_flag", 0))
+        pose = hg_to_pose(car_point[0], f"{name}.car_pos")
+        elbow = finite_number(car_point[1], f"{name}.elbow")
+        return pose, math.radians(elbow)
+
+    def _check_cartesian_positions(self, positions_mm: np.ndarray, label: str) -> None:
+        lim = self.soft_limit_cartesian
+        hit = _first_exit(positions_mm, lim[:, 0], lim[:, 1], 1e-9)
+        if hit is not None:
+            k, axis = hit
+            where = "the target" if k == len(positions_mm) - 1 else "the path"
+            raise value_error(f"{label}: {where} leaves the Cartesian soft limit: "
+                              f"{'xyz'[axis]} = {positions_mm[k, axis]:.2f} mm, limit "
+                              f"[{lim[axis, 0]:g}, {lim[axis, 1]:g}] mm")
+
+    def _check_joint_path(self, qs_deg: np.ndarray, label: str) -> None:
+        lim = self.soft_limit_joint
+        hit = _first_exit(qs_deg, lim[:, 0], lim[:, 1], 1e-9)
+        if hit is not None:
+            k, j = hit
+            raise value_error(f"{label}: the path leaves the joint soft limit: J{j + 1} = "
+                              f"{qs_deg[k, j]:.3f}°, limit [{lim[j, 0]:g}, {lim[j, 1]:g}]°")
+
+    # === queueing ======================================================================================
+    def _queue_joint_move(self, goal_of: Callable[[ArmSetpoint], np.ndarray], label: str) -> dict:
+        """A PTP move to goal_of(start) (rad): synchronized trapezoid at the joint speed ratio."""
         speed = np.radians(self.max_speed_joint) * self.speed_joint / 100.0
         ramp = self.accel_time_joint
+        frames = self.frames
 
-        def plan(start: ArmSetpoint) -> JointMotion:
-            return JointMotion(start, goal, Trapezoid.for_axes(goal - start.joints, speed, ramp))
+        def plan(start: ArmSetpoint) -> ArmMotion:
+            goal = goal_of(start)
+            self._check_joint_target(np.degrees(goal), label)
+            path = LinearJointPath(start.joints, goal)
+            steps = 1 + max(1, math.ceil(np.max(np.abs(np.degrees(path.delta)))))
+            ss = np.linspace(0.0, 1.0, steps)
+            positions = np.array([frames.tool_of(self.kin.flange(path.q(s)))[:3, 3] for s in ss])
+            self._check_cartesian_positions(positions * 1000.0, label)
+            timing = Trapezoid.for_axes(path.delta, speed, ramp)
+            return ArmMotion(path, timing, start.finger, start.finger, ramp, "joint")
         return self._submit(plan, label)
 
-    def _submit(self, plan, label: str) -> dict:
+    def _elbow_goal(self, start_q: np.ndarray, flange: np.ndarray, psi: float | None,
+                    turn: float) -> tuple[float | None, float]:
+        """(psi, turn) for the planners. Abs: psi as given. Rel: psi = the start's arm angle +
+        turn, except where the start or the target is near the arm angle's undefined direction
+        (wrist left or right of the shoulder): there the elbow is carried along without twist
+        and turned by `turn` (psi None)."""
+        if psi is not None:
+            return psi, 0.0
+        kin = self.kin
+        u0 = kin.elbow_direction(start_q)[0]
+        w = kin.wrist_of(flange) - kin.shoulder
+        u1 = w / max(float(np.linalg.norm(w)), 1e-12)
+        if min(kin.reference_strength(u0), kin.reference_strength(u1)) > REL_ELBOW_CLEARANCE:
+            return kin.angle_of(*kin.elbow_direction(start_q)) + turn, 0.0
+        return None, turn
+
+    def _queue_ptp_cartesian(self, target_of: Callable[[np.ndarray], np.ndarray], label: str, *,
+                             psi: float | None = None, turn: float = 0.0) -> dict:
+        """A PTP move to the control-point pose target_of(start pose), with the elbow at arm
+        angle `psi`, or (Rel) turned by `turn` (rad) from where it starts."""
+        frames, kin = self.frames, self.kin
+        lo, hi = np.radians(self.soft_limit_joint[:, 0]), np.radians(self.soft_limit_joint[:, 1])
+
+        def goal_of(start: ArmSetpoint) -> np.ndarray:
+            target = target_of(frames.tool_of(kin.flange(start.joints)))
+            self._check_cartesian_positions(target[None, :3, 3] * 1000.0, label)
+            flange = frames.flange_of(target)
+            goal_psi, goal_turn = self._elbow_goal(start.joints, flange, psi, turn)
+            try:
+                if goal_psi is not None:
+                    return kin.solve(flange, start.joints, psi=goal_psi, lower=lo, upper=hi)
+                u0, n0 = kin.elbow_direction(start.joints)
+                w = kin.wrist_of(flange) - kin.shoulder
+                u1 = w / max(float(np.linalg.norm(w)), 1e-12)
+                elbow = rotate_about(u1, goal_turn) @ kin.transport(n0, u0, u1)
+                return kin.solve(flange, start.joints, elbow_dir=elbow, lower=lo, upper=hi)
+            except Unreachable as e:
+                raise value_error(f"{label}: {e}") from None
+        return self._queue_joint_move(goal_of, label)
+
+    def _queue_cartesian(self, path_of: Callable[[np.ndarray], LinePath], label: str, *,
+                         psi: float | None = None, turn: float = 0.0) -> dict:
+        """A CP move along path_of(start pose); the elbow ends at arm angle `psi`, or (Rel) is
+        turned by `turn` (rad) from where it starts."""
+        frames = self.frames
+        v, w = self.max_speed_cartesian
+        ratio = self.speed_cartesian / 100.0
+        ramp = self.accel_time_cartesian
+        limits = CartesianLimits(
+            speed=v * ratio / 1000.0, angular_speed=math.radians(w * ratio), ramp=ramp,
+            joint_velocity=np.radians(self.max_speed_joint),
+            joint_accel=np.radians(self.max_speed_joint) / self.min_accel_time_joint)
+
+        def plan(start: ArmSetpoint) -> ArmMotion:
+            try:
+                path = path_of(frames.tool_of(self.kin.flange(start.joints)))
+            except ValueError as e:
+                raise value_error(f"{label}: {e}") from None
+            ss = np.linspace(0.0, 1.0, 1 + max(2, math.ceil(path.length / 0.002)))
+            self._check_cartesian_positions(np.array([path.position(s) for s in ss]) * 1000.0,
+                                            label)
+            goal_psi, goal_turn = self._elbow_goal(start.joints, frames.flange_of(path.pose(1.0)),
+                                                   psi, turn)
+            try:
+                result = self.planner.plan(path, frames, start.joints, limits, psi=goal_psi,
+                                           turn=goal_turn)
+            except Unreachable as e:
+                raise value_error(f"{label}: {e}") from None
+            dense = np.linspace(0.0, 1.0, 4 * len(result.path.ss))
+            self._check_joint_path(np.degrees(result.path.spline(dense)), label)
+            return ArmMotion(result.path, result.timing, start.finger, start.finger, ramp,
+                             "cartesian")
+        return self._submit(plan, label)
+
+    def _queue_gripper(self, ratio: int, label: str) -> dict:
+        self._check_can_move()
+        finger = self.finger_max * ratio / 100.0
+        speed = self.config.gripper_speed / 2000.0      # one finger, m/s
+        ramp = self.min_accel_time_joint
+
+        def plan(start: ArmSetpoint) -> ArmMotion:
+            timing = Trapezoid.for_axes(np.array([finger - start.finger]), np.array([speed]), ramp)
+            return ArmMotion(LinearJointPath(start.joints, start.joints), timing, start.finger,
+                             finger, ramp, "gripper")
+        return self._submit(plan, label)
+
+    def _submit(self, plan: Callable[[ArmSetpoint], ArmMotion], label: str) -> dict:
         motion_id = self.device.submit(plan, label)
         if motion_id is None:
-            raise Refused(ReturnCode.FULL_MOTION_QUEUE_ERR,
+            raise Refused(R.FULL_MOTION_QUEUE_ERR,
                           f"the motion queue is full ({self.device.capacity} motions): wait or stop")
         return {"motion_id": motion_id}
 
-    def _stop_motion(self) -> None:
-        self.device.stop(self.accel_time_joint)
+    def _current_ramp(self) -> float:
+        cur = self.device.current
+        return cur.motion.ramp if cur is not None else self.accel_time_joint
+
+    def _stop_motion(self, fastest: bool = False) -> None:
+        cur = self.device.current
+        if fastest:
+            ramp = (self.min_accel_time_cartesian
+                    if cur is not None and cur.motion.kind == "cartesian"
+                    else self.min_accel_time_joint)
+        else:
+            ramp = self._current_ramp()
+        self.device.stop(ramp)

@@ -62,6 +62,7 @@ class Device:
         self.retired_id = 0
         self.completed = 0
         self.discarded = 0
+        self._discarded_ids: deque[tuple[int, int]] = deque(maxlen=256)
 
     # --- called by cores (any thread) -------------------------------------------------------
     @property
@@ -189,6 +190,11 @@ class Device:
                 self.changed.wait(left)
             return True
 
+    def was_discarded(self, motion_id: int) -> bool:
+        """True when motion `motion_id` was discarded by a stop (of the last 256 stops)."""
+        with self.lock:
+            return any(lo <= motion_id <= hi for lo, hi in self._discarded_ids)
+
     def progress(self) -> tuple[int, float]:
         """(current motion id or 0, its completed fraction)."""
         cur = self.current
@@ -233,6 +239,7 @@ class Device:
         self.retired_id = max(self.retired_id, self.current.id)
         if discarded:
             self.discarded += 1
+            self._discarded_ids.append((self.current.id, self.current.id))
             self._stop_at = None
             self.rate = self._rate_target = 1.0
         else:
@@ -243,6 +250,7 @@ class Device:
     def _retire_queue(self) -> None:
         if self.queue:
             self.discarded += len(self.queue)
+            self._discarded_ids.append((self.queue[0].id, self.queue[-1].id))
             self.retired_id = max(self.retired_id, self.queue[-1].id)
             self.queue.clear()
             self.changed.notify_all()

@@ -60,6 +60,26 @@ def answers(fn: Callable[..., dict[str, Any] | Reply | None]) -> Callable[..., R
     return wrapper
 
 
+def returns(*codes: ReturnCode) -> Callable[[Callable[..., Any]], Callable[..., Reply]]:
+    """`answers`, for an operation whose spec lists exactly OK, NG and `codes`: a refusal with
+    any other id becomes NG ("failed for another reason"), comment kept. The allowed ids are
+    the wrapper's `return_codes`, for tests and documentation."""
+    allowed = frozenset((ReturnCode.OK, ReturnCode.NG, *codes))
+
+    def decorate(fn: Callable[..., Any]) -> Callable[..., Reply]:
+        inner = answers(fn)
+
+        @functools.wraps(fn)
+        def wrapper(*args: Any, **kwargs: Any) -> Reply:
+            reply = inner(*args, **kwargs)
+            if reply.code not in allowed:
+                return Reply(ReturnCode.NG, reply.comment, reply.values)
+            return reply
+        wrapper.return_codes = allowed  # type: ignore[attr-defined]
+        return wrapper
+    return decorate
+
+
 def value_error(what: str) -> Refused:
     return Refused(ReturnCode.VALUE_ERR, what)
 

@@ -1,0 +1,298 @@
+"""Kinematics of the 7-axis SRS arm with Pinocchio: forward kinematics, the arm angle, and an
+exact inverse kinematics that honours the arm angle.
+
+Pinocchio loads `urdf/mobile_manipulator.urdf` and reduces it to the seven arm joints; the
+model's root (the universe frame) is `base_link`, the arm frame of the ACT ports. Internally
+everything is SI (m, rad) and poses are 4×4 homogeneous matrices (numpy).
+
+The arm is an SRS arm: joints 1-3 (Z, Y, Z) meet at the shoulder S, joint 4 (Y) is the elbow E,
+joints 5-7 (Z, Y, Z) meet at the wrist W. The arm angle ψ is the rotation of the elbow about the
+shoulder-wrist line u = S→W (right hand), measured from the reference direction ŷ × u: ψ = 0
+puts the elbow on that side (in the start posture, wrist above the shoulder: the elbow points
+forward; reaching forward: the elbow below the line), ψ = ±180° on the other. The reference is
+undefined only where the wrist is straight to the left or right of the shoulder (within
+`LATERAL_CONE`; there ẑ × u takes its place), a place this arm rarely reaches through; the
+start posture and the forward and upward workspace are far from it. Near that direction
+relative moves do not use the reference: they carry the elbow along without twist
+(`transport`) and turn it by the requested amount.
+"""
+from __future__ import annotations
+
+import math
+import threading
+from dataclasses import dataclass
+from itertools import product
+
+import numpy as np
+import pinocchio as pin
+
+from acti_sim.world import ARM_JOINTS, URDF_PATH
+
+TWO_PI = 2.0 * math.pi
+LATERAL_CONE = 1e-3           # rad: where S→W is this close to ±y, ψ is measured from ẑ × u
+_EPS = 1e-9
+# Flags of CarPosWithElbow.struct_flag (reported; moves take the branch nearest the start).
+FLAG_SHOULDER = 0x1   # θ2 < 0
+FLAG_ELBOW = 0x2      # θ4 > 0
+FLAG_WRIST = 0x4      # θ6 < 0
+
+
+class Unreachable(ValueError):
+    """No joint solution: the comment says why (too far, too close, joint limits)."""
+
+
+def rot_z(a: float) -> np.ndarray:
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def rot_y(a: float) -> np.ndarray:
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def rotate_about(axis: np.ndarray, angle: float) -> np.ndarray:
+    """Rotation matrix of `angle` (rad) about the unit vector `axis`."""
+    return pin.exp3(np.asarray(axis, float) * angle)
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v)
+
+
+def wrap(a: float) -> float:
+    """An angle in (-π, π]."""
+    return math.pi - (math.pi - a) % TWO_PI
+
+
+@dataclass(frozen=True)
+class ArmPoints:
+    shoulder: np.ndarray
+    elbow: np.ndarray
+    wrist: np.ndarray
+
+
+class ArmKinematics:
+    """The reduced Pinocchio model of the arm, with thread-local data (one per calling thread)."""
+
+    def __init__(self, urdf_path: str = URDF_PATH, flange: str = "flange") -> None:
+        full = pin.buildModelFromUrdf(urdf_path)
+        lock = [i for i in range(1, full.njoints) if full.names[i] not in ARM_JOINTS]
+        self.model = pin.buildReducedModel(full, lock, pin.neutral(full))
+        if tuple(self.model.names[1:]) != ARM_JOINTS:
+            raise ValueError(f"expected the arm joints {ARM_JOINTS}, got {list(self.model.names)}")
+        self.flange_id = self.model.getFrameId(flange)
+        self.lower = self.model.lowerPositionLimit.copy()
+        self.upper = self.model.upperPositionLimit.copy()
+        self.velocity = self.model.velocityLimit.copy()
+        self._local = threading.local()
+        self._check_srs_layout()
+
+    # --- model data ---------------------------------------------------------------------------
+    @property
+    def data(self) -> pin.Data:
+        d = getattr(self._local, "data", None)
+        if d is None:
+            d = self._local.data = self.model.createData()
+        return d
+
+    def _check_srs_layout(self) -> None:
+        """Read the SRS geometry off the model at q = 0 and make sure it is one."""
+        kinds = [self.model.joints[i].shortname() for i in range(1, 8)]
+        if kinds != ["JointModelRZ", "JointModelRY"] * 3 + ["JointModelRZ"]:
+            raise ValueError(f"not a Z-Y-Z-Y-Z-Y-Z arm: {kinds}")
+        d = self.data
+        pin.forwardKinematics(self.model, d, np.zeros(7))
+        pin.updateFramePlacements(self.model, d)
+        origins = [d.oMi[i].translation.copy() for i in range(1, 8)]
+        flange = d.oMf[self.flange_id]
+        axis_point = origins[0]
+        for i in range(1, 8):
+            if not np.allclose(d.oMi[i].rotation, np.eye(3), atol=1e-9):
+                raise ValueError(f"joint{i} frame is rotated at q = 0; the IK assumes it is not")
+            if not np.allclose(origins[i - 1][:2], axis_point[:2], atol=1e-9):
+                raise ValueError(f"joint{i} is off the arm's vertical line at q = 0")
+        if not (np.allclose(flange.rotation, np.eye(3)) and np.allclose(flange.translation[:2],
+                                                                         axis_point[:2])):
+            raise ValueError("the flange is not on the arm's line at q = 0")
+        self.shoulder = origins[1]                      # joint2: J1, J2, J3 axes meet here
+        self.upper_arm = float(origins[3][2] - origins[1][2])   # S → E (joint4)
+        self.forearm = float(origins[5][2] - origins[3][2])     # E → W (joint6)
+        self.hand = float(flange.translation[2] - origins[5][2])  # W → flange, along its z
+        self.reach = self.upper_arm + self.forearm
+        c_min = math.cos(max(abs(self.lower[3]), abs(self.upper[3])))
+        self.min_reach = math.sqrt(self.upper_arm ** 2 + self.forearm ** 2
+                                   + 2 * self.upper_arm * self.forearm * c_min)
+
+    # --- forward kinematics --------------------------------------------------------------------
+    def flange(self, q: np.ndarray) -> np.ndarray:
+        """Flange pose in the arm frame (4×4, m)."""
+        d = self.data
+        pin.forwardKinematics(self.model, d, np.asarray(q, float))
+        return pin.updateFramePlacement(self.model, d, self.flange_id).homogeneous
+
+    def points(self, q: np.ndarray) -> ArmPoints:
+        d = self.data
+        pin.forwardKinematics(self.model, d, np.asarray(q, float))
+        return ArmPoints(d.oMi[2].translation.copy(), d.oMi[4].translation.copy(),
+                         d.oMi[6].translation.copy())
+
+    # --- the arm angle ---------------------------------------------------------------------------
+    def reference(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(e1, e2): the arm angle's zero direction and its +90° direction, normal to u = S→W."""
+        for v, floor in ((np.array([0.0, 1.0, 0.0]), LATERAL_CONE),
+                         (np.array([0.0, 0.0, 1.0]), 0.0)):
+            e1 = np.cross(v, u)
+            n = np.linalg.norm(e1)
+            if n > floor:
+                e1 = e1 / n
+                return e1, np.cross(u, e1)
+        raise AssertionError("unreachable: y and z cannot both be parallel to u")
+
+    @staticmethod
+    def reference_strength(u: np.ndarray) -> float:
+        """|ŷ × u|: 1 far from the arm angle's undefined direction (u = ±ŷ), 0 on it."""
+        return float(math.hypot(u[0], u[2]))
+
+    def elbow_direction(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(u, n): the unit S→W and the unit direction from the elbow circle's centre to E."""
+        pts = self.points(q)
+        u = _unit(pts.wrist - pts.shoulder)
+        v = pts.elbow - pts.shoulder
+        n = v - np.dot(v, u) * u
+        norm = np.linalg.norm(n)
+        if norm < 1e-9:                      # stretched straight: any elbow angle; report 0
+            return u, self.reference(u)[0]
+        return u, n / norm
+
+    def angle_of(self, u: np.ndarray, n: np.ndarray) -> float:
+        e1, e2 = self.reference(u)
+        return math.atan2(float(np.dot(n, e2)), float(np.dot(n, e1)))
+
+    def arm_angle(self, q: np.ndarray) -> float:
+        """The arm angle ψ (rad) of the posture q."""
+        return self.angle_of(*self.elbow_direction(q))
+
+    @staticmethod
+    def transport(n: np.ndarray, u0: np.ndarray, u1: np.ndarray) -> np.ndarray:
+        """The elbow direction n (normal to u0) carried to u1 by the smallest rotation."""
+        axis = np.cross(u0, u1)
+        sin, cos = float(np.linalg.norm(axis)), float(np.dot(u0, u1))
+        if sin > 1e-12:
+            n = rotate_about(axis / sin, math.atan2(sin, cos)) @ n
+        n = n - np.dot(n, u1) * u1
+        return n / np.linalg.norm(n)
+
+    def direction_at(self, u: np.ndarray, psi: float) -> np.ndarray:
+        e1, e2 = self.reference(u)
+        return math.cos(psi) * e1 + math.sin(psi) * e2
+
+    @staticmethod
+    def flags(q: np.ndarray) -> int:
+        """The branch of q as CarPosWithElbow.struct_flag bits."""
+        return ((FLAG_SHOULDER if q[1] < 0 else 0) | (FLAG_ELBOW if q[3] > 0 else 0)
+                | (FLAG_WRIST if q[5] < 0 else 0))
+
+    def wrist_of(self, flange: np.ndarray) -> np.ndarray:
+        return flange[:3, 3] - self.hand * flange[:3, 2]
+
+    # --- inverse kinematics ------------------------------------------------------------------------
+    def solve(self, flange: np.ndarray, reference_q: np.ndarray, *, psi: float | None = None,
+              elbow_dir: np.ndarray | None = None, lower: np.ndarray | None = None,
+              upper: np.ndarray | None = None) -> np.ndarray:
+        """Joints (rad) that put the flange at `flange` (4×4, m) with the elbow at arm angle `psi`
+        (rad) or towards `elbow_dir` (a unit vector normal to S→W), nearest to `reference_q`
+        among the solutions within [lower, upper] (default: the model's limits).
+        Raises Unreachable with the reason when there is none."""
+        lower = self.lower if lower is None else lower
+        upper = self.upper if upper is None else upper
+        ref = np.asarray(reference_q, float)
+        R, w = flange[:3, :3], self.wrist_of(flange)
+        v = w - self.shoulder
+        dist = float(np.linalg.norm(v))
+        a, b = self.upper_arm, self.forearm
+        if dist > self.reach + 1e-9:
+            raise Unreachable(f"out of reach: the wrist would be {dist * 1e3:.1f} mm from the "
+                              f"shoulder, the arm reaches {self.reach * 1e3:.1f} mm")
+        if dist < self.min_reach - 1e-9:
+            raise Unreachable(f"too close: the wrist would be {dist * 1e3:.1f} mm from the "
+                              f"shoulder, the elbow folds to {self.min_reach * 1e3:.1f} mm")
+        u = v / dist
+        h = (a * a - b * b + dist * dist) / (2 * dist)
+        rho = math.sqrt(max(a * a - h * h, 0.0))
+        if elbow_dir is None:
+            elbow_dir = self.direction_at(u, 0.0 if psi is None else psi)
+        n = elbow_dir - np.dot(elbow_dir, u) * u
+        n = n / np.linalg.norm(n)
+        elbow = self.shoulder + h * u + rho * n
+        # The branch with the reference's signs of θ2, θ4, θ6 comes first; when none of those is
+        # near zero it is the nearest, and the search stops there.
+        clear = min(abs(ref[1]), abs(ref[3]), abs(ref[5])) > 0.2
+        best, best_cost = None, math.inf
+        for q in self._branches(elbow, w, R, ref):
+            q = self._nearest_in_limits(q, ref, lower, upper)
+            if q is None:
+                continue
+            if clear and best is None and np.all(np.sign(q[1::2]) == np.sign(ref[1::2])):
+                best = q
+                break
+            cost = float(np.sum((q - ref) ** 2))
+            if cost < best_cost:
+                best, best_cost = q, cost
+        if best is None:
+            raise Unreachable("no joint solution within the joint limits for this pose and elbow")
+        self._verify(best, flange)
+        return best
+
+    def _branches(self, elbow: np.ndarray, wrist: np.ndarray, R: np.ndarray, ref: np.ndarray):
+        ua = (elbow - self.shoulder) / self.upper_arm
+        t2 = math.acos(max(-1.0, min(1.0, ua[2])))
+        if math.sin(t2) < 1e-9:
+            shoulders = [(ref[0], t2), (ref[0], -t2)]
+        else:
+            t1 = math.atan2(ua[1], ua[0])
+            shoulders = [(t1, t2), (t1 + math.pi, -t2)]
+        if ref[1] < 0:
+            shoulders.reverse()
+        elbows = (-1.0, 1.0) if ref[3] < 0 else (1.0, -1.0)
+        wrists = (-1.0, 1.0) if ref[5] < 0 else (1.0, -1.0)
+        f = (wrist - elbow) / self.forearm
+        for (t1, t2), elbow_sign, wrist_sign in product(shoulders, elbows, wrists):
+            r12 = rot_z(t1) @ rot_y(t2)
+            f2 = r12.T @ f
+            t4 = elbow_sign * math.acos(max(-1.0, min(1.0, f2[2])))
+            if abs(math.sin(t4)) < 1e-9:
+                t3 = ref[2]
+            else:
+                sg = 1.0 if t4 > 0 else -1.0
+                t3 = math.atan2(sg * f2[1], sg * f2[0])
+            rw = (r12 @ rot_z(t3) @ rot_y(t4)).T @ R
+            t6 = wrist_sign * math.acos(max(-1.0, min(1.0, rw[2, 2])))
+            if abs(math.sin(t6)) < 1e-9:
+                t5 = ref[4]
+                t7 = math.atan2(rw[1, 0], rw[0, 0]) - t5
+            else:
+                sg = 1.0 if t6 > 0 else -1.0
+                t5 = math.atan2(sg * rw[1, 2], sg * rw[0, 2])
+                t7 = math.atan2(sg * rw[2, 1], -sg * rw[2, 0])
+            yield np.array([t1, t2, t3, t4, t5, t6, t7])
+
+    @staticmethod
+    def _nearest_in_limits(q: np.ndarray, ref: np.ndarray, lower: np.ndarray,
+                           upper: np.ndarray) -> np.ndarray | None:
+        """Each angle moved by whole turns to the value nearest the reference within its limits."""
+        out = np.empty(len(q))
+        for i, (x, r, lo, hi) in enumerate(zip(q, ref, lower, upper)):
+            k0 = round((r - x) / TWO_PI)
+            options = [x + TWO_PI * k for k in (k0 - 1, k0, k0 + 1)]
+            options = [y for y in options if lo - 1e-9 <= y <= hi + 1e-9]
+            if not options:
+                return None
+            out[i] = min(options, key=lambda y: abs(y - r))
+        return out
+
+    def _verify(self, q: np.ndarray, flange: np.ndarray) -> None:
+        got = self.flange(q)
+        if (np.max(np.abs(got[:3, 3] - flange[:3, 3])) > 1e-7
+                or np.max(np.abs(got[:3, :3] - flange[:3, :3])) > 1e-6):
+            raise AssertionError(f"IK solution does not reproduce the pose:\n{got}\n{flange}")

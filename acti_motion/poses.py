@@ -1,0 +1,94 @@
+"""Poses of the ACT ports: HgMatrix (float64[12], 3×4 row by row, translation in mm) ↔ 4×4 (m).
+
+Internally a pose is a 4×4 homogeneous numpy matrix in metres. A rotation part read from a
+request must be a rotation within a small tolerance (rounded values such as 0.7071 pass); it is
+then made exactly orthonormal.
+"""
+from __future__ import annotations
+
+import math
+from typing import Iterable
+
+import numpy as np
+import pinocchio as pin
+
+from acti_motion.replies import Refused, ReturnCode, finite_vector
+
+ROTATION_TOLERANCE = 1e-3
+
+
+def identity_hg() -> list[float]:
+    return pose_to_hg(np.eye(4))
+
+
+def hg_to_pose(values: Iterable[float], name: str,
+               code: ReturnCode = ReturnCode.VALUE_ERR) -> np.ndarray:
+    """A 4×4 pose (m) from an HgMatrix, else Refused(code) that says what is wrong."""
+    try:
+        v = finite_vector(values, 12, name)
+    except Refused as r:
+        raise Refused(code, r.comment) from None
+    m = v.reshape(3, 4)
+    R = m[:, :3]
+    err = float(np.max(np.abs(R.T @ R - np.eye(3))))
+    if err > ROTATION_TOLERANCE or np.linalg.det(R) <= 0:
+        raise Refused(code, f"{name}: the 3×3 part is not a rotation (orthonormal, det +1): "
+                            f"|RᵀR − I| = {err:.3g}, det = {np.linalg.det(R):.3g}")
+    T = np.eye(4)
+    u, _, vt = np.linalg.svd(R)
+    T[:3, :3] = u @ vt
+    T[:3, 3] = m[:, 3] / 1000.0
+    return T
+
+
+def pose_to_hg(T: np.ndarray) -> list[float]:
+    m = np.array(T[:3, :4], dtype=float)
+    m[:, 3] *= 1000.0
+    return [float(x) for x in m.reshape(-1)]
+
+
+def inverse(T: np.ndarray) -> np.ndarray:
+    out = np.eye(4)
+    R = T[:3, :3]
+    out[:3, :3] = R.T
+    out[:3, 3] = -R.T @ T[:3, 3]
+    return out
+
+
+def rotation_angle(R0: np.ndarray, R1: np.ndarray) -> float:
+    """Angle (rad) of the rotation that takes R0 to R1."""
+    return float(np.linalg.norm(pin.log3(R1 @ R0.T)))
+
+
+def compose_relative(start: np.ndarray, delta: np.ndarray) -> np.ndarray:
+    """The Cartesian Rel rule, in the robot frame: p' = p + Δp, R' = ΔR·R."""
+    out = np.eye(4)
+    out[:3, :3] = delta[:3, :3] @ start[:3, :3]
+    out[:3, 3] = start[:3, 3] + delta[:3, 3]
+    return out
+
+
+def position_error_mm(A: np.ndarray, B: np.ndarray) -> float:
+    return float(np.linalg.norm(A[:3, 3] - B[:3, 3]) * 1000.0)
+
+
+def orientation_error_deg(A: np.ndarray, B: np.ndarray) -> float:
+    return math.degrees(rotation_angle(A[:3, :3], B[:3, :3]))
+
+
+class Frames:
+    """The two offsets of the middle-level port: `base` = the robot frame seen from the arm frame
+    (setBaseOffset), `tool` = the control point seen from the flange (setControlPointOffset)."""
+
+    def __init__(self, base: np.ndarray | None = None, tool: np.ndarray | None = None) -> None:
+        self.base = np.eye(4) if base is None else base
+        self.tool = np.eye(4) if tool is None else tool
+        self._base_inv, self._tool_inv = inverse(self.base), inverse(self.tool)
+
+    def flange_of(self, P: np.ndarray) -> np.ndarray:
+        """Flange pose (arm frame) that puts the control point at P (robot frame)."""
+        return self.base @ P @ self._tool_inv
+
+    def tool_of(self, F: np.ndarray) -> np.ndarray:
+        """Control-point pose (robot frame) of the flange pose F (arm frame)."""
+        return self._base_inv @ F @ self.tool

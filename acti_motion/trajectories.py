@@ -1,0 +1,357 @@
+"""Arm motions: joint paths, their timing, and Cartesian lines and arcs turned into joint paths.
+
+A motion is a joint path q(s), s ∈ [0, 1], timed by s(t): a synchronized trapezoid (PTP, and CP
+where it keeps every joint limit) or TOPP-RA's time-optimal timing under the same limits (CP
+near singularities). The finger moves linearly in s, so gripper commands are motions too and
+queue with the moves.
+
+CP moves sample the exact Cartesian path with the analytic IK (one solution per sample, each the
+nearest to the one before), refine the sampling until the joint spline reproduces the path
+within `PATH_TOLERANCE_MM` / `PATH_TOLERANCE_DEG`, and check the soft limits on the result.
+"""
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+import pinocchio as pin
+from scipy.interpolate import CubicSpline
+
+from acti_motion.kinematics import ArmKinematics, Unreachable, rotate_about, wrap
+from acti_motion.poses import Frames, rotation_angle
+from acti_motion.profiles import Trapezoid
+from acti_sim.world import World
+
+PATH_TOLERANCE_MM = 0.02
+PATH_TOLERANCE_DEG = 0.01
+MAX_JOINT_STEP = math.radians(2.0)   # between IK samples of a CP path
+MAX_SAMPLES = 4000
+TOPPRA_GRID = 201
+
+
+def load_toppra():
+    """toppra, imported on first use (the import takes about a second)."""
+    import toppra
+    logging.getLogger("toppra").setLevel(logging.WARNING)
+    return toppra
+
+
+@dataclass(frozen=True)
+class ArmSetpoint:
+    """What the arm is commanded to hold: joints (rad) and the finger position (m)."""
+    joints: np.ndarray
+    finger: float
+
+
+# --- joint paths ----------------------------------------------------------------------------------
+class JointPath(Protocol):
+    def q(self, s: float) -> np.ndarray: ...
+
+    def dq(self, s: float) -> np.ndarray: ...
+
+
+class LinearJointPath:
+    """The joint-space straight line of PTP moves (and a standing path for gripper moves)."""
+
+    def __init__(self, q0: np.ndarray, q1: np.ndarray) -> None:
+        self.q0 = np.asarray(q0, float)
+        self.delta = np.asarray(q1, float) - self.q0
+
+    def q(self, s: float) -> np.ndarray:
+        return self.q0 + s * self.delta
+
+    def dq(self, s: float) -> np.ndarray:
+        return self.delta
+
+
+class SplineJointPath:
+    """A cubic spline through IK samples (s_i, q_i) of a Cartesian path."""
+
+    def __init__(self, ss: np.ndarray, qs: np.ndarray) -> None:
+        self.ss, self.qs = ss, qs
+        self.spline = CubicSpline(ss, qs, axis=0)
+        self.d1 = self.spline.derivative(1)
+        self.d2 = self.spline.derivative(2)
+
+    def q(self, s: float) -> np.ndarray:
+        return self.spline(s)
+
+    def dq(self, s: float) -> np.ndarray:
+        return self.d1(s)
+
+
+# --- timing ---------------------------------------------------------------------------------------
+class Timing(Protocol):
+    duration: float
+
+    def sample(self, t: float) -> tuple[float, float]: ...
+
+
+class _PathParameter:
+    """s itself as a one-axis path: ParametrizeConstAccel over it yields s(t) and ds/dt."""
+    dof = 1
+
+    def __call__(self, ss, order: int = 0) -> np.ndarray:
+        ss = np.atleast_1d(np.asarray(ss, float))
+        return (ss if order == 0 else np.full(len(ss), 1.0 if order == 1 else 0.0))[:, None]
+
+
+class ConstAccelTiming:
+    """TOPP-RA's path velocities at its grid points, constant path acceleration in between
+    (toppra's ParametrizeConstAccel, which keeps the acceleration limits between grid points)."""
+
+    def __init__(self, gridpoints: np.ndarray, velocities: np.ndarray) -> None:
+        ta = load_toppra()
+        v = np.maximum(np.asarray(velocities, float), 0.0)
+        if np.any(v[:-1] + v[1:] <= 0.0):
+            raise Unreachable("the time-optimal timing stops inside the path")
+        self._p = ta.parametrizer.ParametrizeConstAccel(_PathParameter(), gridpoints, v)
+        self.duration = float(self._p.duration)
+
+    def sample(self, t: float) -> tuple[float, float]:
+        if t >= self.duration:
+            return 1.0, 0.0
+        t = max(t, 0.0)
+        return float(self._p(t)[0]), float(self._p(t, 1)[0])
+
+
+# --- the motion the executor runs -------------------------------------------------------------------
+class ArmMotion:
+    """A joint path timed by a profile; the finger goes from finger0 to finger1 along s.
+    `ramp` is the accel time pause and stop use for it; `kind` is "joint", "cartesian", "gripper"."""
+
+    def __init__(self, path: JointPath, timing: Timing, finger0: float, finger1: float,
+                 ramp: float, kind: str) -> None:
+        self.path, self.timing, self.ramp, self.kind = path, timing, ramp, kind
+        self.finger0, self.dfinger = finger0, finger1 - finger0
+        self.duration = timing.duration
+
+    def at(self, t: float) -> ArmSetpoint:
+        s, _ = self.timing.sample(t)
+        return ArmSetpoint(self.path.q(s), self.finger0 + s * self.dfinger)
+
+    def apply(self, world: World, t: float, rate: float) -> None:
+        s, ds = self.timing.sample(t)
+        world.set_arm_targets(self.path.q(s), rate * ds * self.path.dq(s))
+        if self.dfinger:
+            world.set_gripper_target(self.finger0 + s * self.dfinger)
+
+
+# --- Cartesian paths of the control point (robot frame, m) ---------------------------------------
+class LinePath:
+    """Straight line and rotation geodesic, both linear in s."""
+
+    def __init__(self, P0: np.ndarray, P1: np.ndarray) -> None:
+        self.p0, self.dp = P0[:3, 3].copy(), P1[:3, 3] - P0[:3, 3]
+        self.R0 = P0[:3, :3].copy()
+        self.w = pin.log3(P1[:3, :3] @ self.R0.T)
+        self.length = float(np.linalg.norm(self.dp))
+        self.angle = float(np.linalg.norm(self.w))
+
+    def position(self, s: float) -> np.ndarray:
+        return self.p0 + s * self.dp
+
+    def pose(self, s: float) -> np.ndarray:
+        T = np.eye(4)
+        T[:3, :3] = pin.exp3(s * self.w) @ self.R0
+        T[:3, 3] = self.position(s)
+        return T
+
+
+class ArcPath(LinePath):
+    """Circular arc from P0 through the point `via` to P1; the orientation follows the geodesic
+    from P0's to P1's, linearly in arc length."""
+
+    def __init__(self, P0: np.ndarray, via: np.ndarray, P1: np.ndarray) -> None:
+        super().__init__(P0, P1)
+        a, b, c = P0[:3, 3], np.asarray(via, float), P1[:3, 3]
+        ab, ac = b - a, c - a
+        normal = np.cross(ab, ac)
+        scale = np.linalg.norm(ab) * np.linalg.norm(ac)
+        if scale < 1e-12 or np.linalg.norm(normal) < 1e-6 * scale:
+            raise ValueError("the start, via and end points are on one line (or coincide): "
+                             "no circle passes through them")
+        n2 = float(np.dot(normal, normal))
+        self.center = a + (np.dot(ab, ab) * np.cross(ac, normal)
+                           + np.dot(ac, ac) * np.cross(normal, ab)) / (2 * n2)
+        self.normal = normal / math.sqrt(n2)
+        self.radius = float(np.linalg.norm(a - self.center))
+        r0, r1 = a - self.center, c - self.center
+        self.sweep = math.atan2(float(np.dot(np.cross(r0, r1), self.normal)),
+                                float(np.dot(r0, r1))) % (2 * math.pi)
+        self.length = self.radius * self.sweep
+        self._r0 = r0
+
+    def position(self, s: float) -> np.ndarray:
+        return self.center + rotate_about(self.normal, s * self.sweep) @ self._r0
+
+
+# --- planning ---------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class CartesianLimits:
+    """Nominal CP profile (control point speeds, accel time) and the joint limits it must keep."""
+    speed: float              # m/s
+    angular_speed: float      # rad/s (orientation and elbow)
+    ramp: float               # s
+    joint_velocity: np.ndarray  # rad/s
+    joint_accel: np.ndarray     # rad/s²
+
+
+@dataclass
+class CartesianPlan:
+    path: SplineJointPath
+    timing: Timing
+    elbow_turn: float         # rad the elbow turns about the shoulder-wrist line
+    retimed: bool             # TOPP-RA timing instead of the nominal trapezoid
+    nominal: Trapezoid
+
+
+class CartesianPlanner:
+    """Turns a control-point path into a joint spline and a timing (see the module notes)."""
+
+    def __init__(self, kin: ArmKinematics) -> None:
+        self.kin = kin
+
+    def plan(self, path: LinePath, frames: Frames, start_q: np.ndarray, limits: CartesianLimits,
+             *, psi: float | None = None, turn: float = 0.0) -> CartesianPlan:
+        """Joint spline and timing that move the control point along `path` (robot frame) while
+        the elbow, carried along without twist, turns by `turn` (rad) or, when `psi` is given,
+        by what it takes to end at the arm angle `psi`."""
+        elbow = self._elbow_plan(path, frames.flange_of, start_q, psi, turn)
+        turn = elbow.turn
+        ss, qs = self._sample(path, frames, start_q, elbow)
+        spline = SplineJointPath(ss, qs)
+        extents = np.array([path.length, path.angle, abs(turn)])
+        speeds = np.array([limits.speed, limits.angular_speed, limits.angular_speed])
+        nominal = Trapezoid.for_axes(extents, speeds, limits.ramp)
+        if self._keeps_limits(spline, nominal, limits):
+            return CartesianPlan(spline, nominal, turn, False, nominal)
+        timing = time_optimal(ss, qs, extents, limits)
+        return CartesianPlan(spline, timing, turn, True, nominal)
+
+    # --- the elbow along the path: transported without twist, plus an even turn to the target ---
+    def _elbow_plan(self, path, to_flange, start_q, psi, turn) -> "_ElbowPlan":
+        kin = self.kin
+        grid = np.linspace(0.0, 1.0, 129)
+        us = np.array([_unit(kin.wrist_of(to_flange(path.pose(s))) - kin.shoulder) for s in grid])
+        n = kin.elbow_direction(start_q)[1]
+        ns = np.empty_like(us)
+        for i, u in enumerate(us):
+            n = _unit(n - np.dot(n, u) * u)
+            ns[i] = n
+        if psi is not None:
+            turn = wrap(psi - kin.angle_of(us[-1], ns[-1]))
+        return _ElbowPlan(grid, ns, turn)
+
+    def _sample(self, path, frames, start_q, elbow) -> tuple[np.ndarray, np.ndarray]:
+        kin, to_flange = self.kin, frames.flange_of
+        count = 1 + max(8, math.ceil(path.length / 0.02), math.ceil(path.angle / 0.1),
+                        math.ceil(abs(elbow.turn) / 0.1))
+        ss = list(np.linspace(0.0, 1.0, min(count, 200)))
+
+        def solve(s: float, ref: np.ndarray) -> np.ndarray:
+            F = to_flange(path.pose(s))
+            u = _unit(kin.wrist_of(F) - kin.shoulder)
+            try:
+                return kin.solve(F, ref, elbow_dir=elbow.direction(s, u))
+            except Unreachable as e:
+                raise Unreachable(f"at {100 * s:.1f} % of the path: {e}") from None
+
+        qs = [np.asarray(start_q, float)]
+        for s in ss[1:]:
+            qs.append(solve(s, qs[-1]))
+        # refine where a joint steps too far (a fast joint near a singularity, or a branch jump)
+        for _ in range(40):
+            todo = [i for i in range(len(ss) - 1)
+                    if np.max(np.abs(qs[i + 1] - qs[i])) > MAX_JOINT_STEP]
+            if not todo:
+                break
+            ss, qs = _insert(ss, qs, todo, solve)
+            if len(ss) > MAX_SAMPLES or min(np.diff(ss)) < 1e-7:
+                raise Unreachable("the path runs through a singularity (a joint would jump)")
+        # refine where the spline strays from the path
+        for _ in range(8):
+            spline = CubicSpline(ss, qs, axis=0)
+            mids = [(ss[i] + ss[i + 1]) / 2 for i in range(len(ss) - 1)]
+            todo = [i for i, s in enumerate(mids)
+                    if _strays(path.pose(s), frames.tool_of(kin.flange(spline(s))))]
+            if not todo:
+                break
+            ss, qs = _insert(ss, qs, todo, solve)
+        return np.array(ss), np.array(qs)
+
+    @staticmethod
+    def _keeps_limits(spline: SplineJointPath, nominal: Trapezoid,
+                      limits: CartesianLimits) -> bool:
+        if nominal.duration <= 0.0:
+            return True
+        ts = np.linspace(0.0, nominal.duration, 401)
+        sv = np.array([nominal.sample(t) for t in ts])
+        s, sd = sv[:, 0], sv[:, 1]
+        sdd = np.gradient(sd, ts)
+        d1, d2 = spline.d1(s), spline.d2(s)
+        qd = d1 * sd[:, None]
+        qdd = d2 * (sd ** 2)[:, None] + d1 * sdd[:, None]
+        return bool(np.all(np.abs(qd) <= limits.joint_velocity * (1 + 1e-6))
+                    and np.all(np.abs(qdd) <= limits.joint_accel * (1 + 1e-3)))
+
+
+@dataclass
+class _ElbowPlan:
+    grid: np.ndarray
+    base: np.ndarray     # transported elbow directions on the grid
+    turn: float
+
+    def direction(self, s: float, u: np.ndarray) -> np.ndarray:
+        i = min(int(s * (len(self.grid) - 1)), len(self.grid) - 2)
+        f = (s - self.grid[i]) / (self.grid[i + 1] - self.grid[i])
+        n = (1 - f) * self.base[i] + f * self.base[i + 1]
+        n = _unit(n - np.dot(n, u) * u)
+        return rotate_about(u, self.turn * s) @ n
+
+
+def time_optimal(ss: np.ndarray, qs: np.ndarray, extents: np.ndarray,
+                 limits: CartesianLimits, grid: int = TOPPRA_GRID) -> ConstAccelTiming:
+    """TOPP-RA timing of the joint spline under the joint limits and the nominal Cartesian
+    speed and acceleration (as three extra axes that grow linearly in s)."""
+    ta = load_toppra()
+    way = np.hstack([qs, ss[:, None] * extents[None, :]])
+    path = ta.SplineInterpolator(ss, way)
+    cart_v = np.array([limits.speed, limits.angular_speed, limits.angular_speed])
+    vlim = np.concatenate([limits.joint_velocity, cart_v])
+    alim = np.concatenate([limits.joint_accel, cart_v / limits.ramp])
+    constraints = [ta.constraint.JointVelocityConstraint(np.stack([-vlim, vlim], axis=1)),
+                   ta.constraint.JointAccelerationConstraint(np.stack([-alim, alim], axis=1))]
+    gridpoints = np.linspace(ss[0], ss[-1], grid)
+    instance = ta.algorithm.TOPPRA(constraints, path, gridpoints=gridpoints,
+                                   parametrizer="ParametrizeConstAccel")
+    sd = instance.compute_parameterization(0.0, 0.0)[1]
+    if sd is None or np.any(np.isnan(sd)):
+        raise Unreachable("no timing keeps the joint limits along this path")
+    return ConstAccelTiming(gridpoints, sd)
+
+
+def _insert(ss, qs, where, solve):
+    """Insert the midpoints of the intervals `where` (solved from their left sample)."""
+    new_s, new_q = [ss[0]], [qs[0]]
+    marks = set(where)
+    for i in range(len(ss) - 1):
+        if i in marks:
+            m = (ss[i] + ss[i + 1]) / 2
+            new_s.append(m)
+            new_q.append(solve(m, qs[i]))
+        new_s.append(ss[i + 1])
+        new_q.append(qs[i + 1])
+    return new_s, new_q
+
+
+def _strays(want: np.ndarray, got: np.ndarray) -> bool:
+    return (np.linalg.norm(want[:3, 3] - got[:3, 3]) * 1000.0 > PATH_TOLERANCE_MM
+            or math.degrees(rotation_angle(want[:3, :3], got[:3, :3])) > PATH_TOLERANCE_DEG)
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v)

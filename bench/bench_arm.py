@@ -1,0 +1,142 @@
+"""Arm figures: move accept latency while moving (over DDS), PTP duration vs the analytic
+trapezoid, CP duration vs the TOPP-RA time-optimal bound, tracking in the simulation.
+Prints figures only (no timing asserts)."""
+import math
+import time
+
+import numpy as np
+from common import RosClient, latencies, row, running
+
+from acti_msgs import srv
+from acti_msgs.msg import CarPosWithElbow
+from std_srvs.srv import Trigger
+
+N = 200
+IDENTITY = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+ARM = "/acti_middle_node/"
+
+
+def accept_latency() -> None:
+    ros = RosClient()
+    with running("bench.trigger_server"), running("acti_middle_node", "queue_size:=2000"):
+        bare = latencies(lambda: ros.call(Trigger, "/bare_trigger/trigger"), N)
+        ros.call(srv.ServoON, ARM + "servo_on")
+        ros.call(srv.SetSpeedJoint, ARM + "set_speed_joint", spd_ratio=5)
+        ros.call(srv.SetSpeedCartesian, ARM + "set_speed_cartesian", spd_ratio=5)
+        # a long first move keeps the arm moving while the others queue behind it
+        ros.call(srv.MovePTPJointRel, ARM + "move_ptp_joint_rel", joint_points=[60.0] + [0.0] * 6)
+        time.sleep(0.3)
+        sign = [1.0]
+
+        def ptp():
+            sign[0] = -sign[0]
+            r = ros.call(srv.MovePTPJointRel, ARM + "move_ptp_joint_rel",
+                         joint_points=[0.5 * sign[0]] * 7)
+            assert r.return_id.id == 0, r.return_id.comment
+
+        def cp():
+            sign[0] = -sign[0]
+            m = list(IDENTITY)
+            m[3] = 20.0 * sign[0]
+            r = ros.call(srv.MoveLinearCartesianRel, ARM + "move_linear_cartesian_rel",
+                         car_point=CarPosWithElbow(car_pos=m))
+            assert r.return_id.id == 0, r.return_id.comment
+        state = latencies(lambda: ros.call(srv.GetState, ARM + "get_state"), N)
+        ptp_lat = latencies(ptp, N, warmup=10)
+        cp_lat = latencies(cp, N, warmup=10)
+        moving = ros.call(srv.GetState, ARM + "get_state").state & 0x02
+    print(f"round trip over DDS, {N} calls each, arm moving: {bool(moving)} (real time)")
+    print(row("std_srvs/Trigger (bare baseline)", bare))
+    print(row("get_state while moving", state, bare))
+    print(row("move_ptp_joint_rel accept", ptp_lat, bare))
+    print(row("move_linear_cartesian_rel (20 mm)", cp_lat, bare))
+    ros.close()
+
+
+def motion_figures() -> None:
+    from acti_motion.arm import ArmConfig, ArmCore
+    from acti_motion.executor import MotionExecutor
+    from acti_motion.poses import orientation_error_deg, pose_to_hg, position_error_mm
+    from acti_motion.trajectories import (CartesianLimits, ConstAccelTiming, LinePath,
+                                          load_toppra, time_optimal)
+    from acti_sim.world import World
+
+    world = World()
+    ex = MotionExecutor(world, real_time_factor=0.0)
+    arm = ArmCore(ex, ArmConfig(initial_joints_deg=(0.0, 45.0, 0.0, -90.0, 0.0, 45.0, 0.0)))
+    arm.servo_on()
+    arm.set_speed_joint(60)
+    arm.set_speed_cartesian(60)
+
+    def run(check=None) -> float:
+        t0 = world.time
+        while arm.device.busy:
+            ex.step()
+            if check:
+                check()
+        return world.time - t0
+
+    print("\nPTP: duration in the simulation vs the analytic synchronized trapezoid")
+    speed = arm.max_speed_joint * 0.6
+    for delta in ([30.0] * 7, [5.0, -60.0, 0.0, 40.0, 0.0, 10.0, 0.0], [1.0] * 7):
+        assert arm.move_ptp_joint_rel(delta).ok
+        took = run()
+        analytic = max(np.max(np.abs(delta) / speed), arm.accel_time_joint) + arm.accel_time_joint
+        print(f"  Δq {str(delta):<42} sim {took:6.3f} s   analytic {analytic:6.3f} s"
+              f"   ratio {took / analytic:5.3f}")
+
+    print("\nCP at 100 %: duration vs the TOPP-RA time-optimal bound (same joint and Cartesian "
+          "limits), tracking in the simulation")
+    load_toppra()
+    arm.set_speed_cartesian(100)
+    cases = [("200 mm line", [0.2, 0.0, -0.2], None),
+             ("300 mm line + 30° turn", [0.1, 0.25, -0.15], [0.0, 0.0, 30.0]),
+             ("near the wrist singularity", None, None)]
+    for name, dp, rot in cases:
+        if dp is None:
+            arm.move_ptp_joint_abs([20, 40, 10, -70, 30, 25, 0])
+            run()
+            target = arm.tool_pose(np.radians([-20, 40, -10, -70, -30, -25, 8]))
+        else:
+            target = arm.tool_pose(arm.device.hold.joints)
+            target[:3, 3] += dp
+            if rot is not None:
+                import pinocchio as pin
+                target[:3, :3] = pin.exp3(np.radians(rot)) @ target[:3, :3]
+        P0 = arm.tool_pose(arm.device.hold.joints)
+        elbow = math.degrees(arm.kin.arm_angle(arm.device.hold.joints))
+        t0 = time.perf_counter()
+        r = arm.move_linear_cartesian_abs((pose_to_hg(target), elbow, 0))
+        plan_ms = (time.perf_counter() - t0) * 1e3
+        assert r.ok, r.comment
+        motion = arm.device.queue[0].motion
+        path = motion.path
+        v, w = arm.max_speed_cartesian
+        limits = CartesianLimits(v / 1000, math.radians(w), arm.accel_time_cartesian,
+                                 np.radians(arm.max_speed_joint),
+                                 np.radians(arm.max_speed_joint) / arm.min_accel_time_joint)
+        line = LinePath(P0, target)
+        extents = np.array([line.length, line.angle, 0.0])
+        bound = time_optimal(path.ss, path.qs, extents, limits).duration
+        deviation = []
+
+        def check():
+            P = arm.tool_pose(world.arm_positions())
+            v_ = P[:3, 3] - P0[:3, 3]
+            d = target[:3, 3] - P0[:3, 3]
+            deviation.append(np.linalg.norm(v_ - np.dot(v_, d) / np.dot(d, d) * d) * 1000)
+        took = run(check)
+        for _ in range(60):
+            ex.step()
+        P = arm.tool_pose(world.arm_positions())
+        timing = "TOPP-RA" if isinstance(motion.timing, ConstAccelTiming) else "trapezoid"
+        print(f"  {name:<28} {timing:<9} plan {plan_ms:6.1f} ms  duration {took:6.3f} s  "
+              f"bound {bound:6.3f} s  ratio {took / bound:5.3f}  max dev {max(deviation):.4f} mm"
+              f"  final {position_error_mm(P, target):.4f} mm"
+              f" {orientation_error_deg(P, target):.4f}°")
+    world.close()
+
+
+if __name__ == "__main__":
+    motion_figures()
+    accept_latency()

@@ -1,0 +1,212 @@
+"""acti_middle_node as a real process over DDS: every operation as a service, the ~/move and
+~/wait_motion actions (feedback, cancel), the ~/state topic, nested messages both ways."""
+import math
+import time
+
+import pytest
+from acti_msgs import srv
+from acti_msgs.action import Move, WaitMotion
+from acti_msgs.msg import ArmState, CarPosWithElbow, LimitValue
+from action_msgs.msg import GoalStatus
+from rclpy.action import ActionClient
+
+from acti_middle_node.operations import OPERATIONS
+from ros_harness import node_fixture, wait_until
+
+arm_node = node_fixture("acti_middle_node", "queue_size:=4")
+ARM = "/acti_middle_node/"
+IDENTITY = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+ACTION_TIMEOUT = 60.0
+
+
+def call(ros, name, srv_type, **fields):
+    return ros.call(srv_type, ARM + name, **fields)
+
+
+def ready(ros):
+    call(ros, "clear_alarms", srv.ClearAlarms)
+    assert call(ros, "servo_on", srv.ServoON).return_id.id == 0
+    assert call(ros, "set_speed_joint", srv.SetSpeedJoint, spd_ratio=80).return_id.id == 0
+    assert call(ros, "set_speed_cartesian", srv.SetSpeedCartesian, spd_ratio=80).return_id.id == 0
+
+
+def rel(dx=0.0, dy=0.0, dz=0.0):
+    m = list(IDENTITY)
+    m[3], m[7], m[11] = dx, dy, dz
+    return CarPosWithElbow(car_pos=m, elbow=0.0, struct_flag=0)
+
+
+class Actions:
+    """Goals of one action over the test client's executor."""
+
+    def __init__(self, ros, action_type, name):
+        self.ros, self.type = ros, action_type
+        self.client = ActionClient(ros.node, action_type, ARM + name)
+        assert self.client.wait_for_server(timeout_sec=30.0)
+
+    def spin(self, future, timeout=ACTION_TIMEOUT):
+        self.ros.executor.spin_until_future_complete(future, timeout_sec=timeout)
+        assert future.done(), "no answer in time"
+        return future.result()
+
+    def send(self, feedback=None, **fields):
+        handle = self.spin(self.client.send_goal_async(
+            self.type.Goal(**fields), feedback_callback=feedback))
+        assert handle.accepted
+        return handle
+
+    def result(self, handle):
+        out = self.spin(handle.get_result_async())
+        return out.status, out.result
+
+
+@pytest.fixture(scope="module")
+def move(ros, arm_node):
+    return Actions(ros, Move, "move")
+
+
+@pytest.fixture(scope="module")
+def wait_motion(ros, arm_node):
+    return Actions(ros, WaitMotion, "wait_motion")
+
+
+def test_every_operation_is_a_service_plus_actions_and_state(ros, arm_node):
+    assert wait_until(lambda: ARM + "go_home" in dict(ros.node.get_service_names_and_types()),
+                      30.0)
+    services = dict(ros.node.get_service_names_and_types())
+    for op in OPERATIONS:
+        want = op.srv_type.__module__.split(".")[0] + "/srv/" + op.srv_type.__name__
+        assert services.get(ARM + op.name) == [want], op.name
+    # discovery of the topic may trail that of the services
+    assert wait_until(lambda: dict(ros.node.get_topic_names_and_types()).get(ARM + "state")
+                      == ["acti_msgs/msg/ArmState"], 30.0)
+
+
+def test_nested_messages_both_ways(ros, arm_node):
+    info = call(ros, "get_manip_info", srv.GetManipInfo).manip_info
+    assert (info.axis_num, info.cmd_cycle, info.is_gripper) == (7, 4, True)
+    limits = call(ros, "get_soft_limit_joint", srv.GetSoftLimitJoint).soft_limit
+    assert len(limits) == 7 and limits[1].upper == pytest.approx(120.0, abs=1e-3)
+    new = [LimitValue(upper=lim.upper - 1.0, lower=lim.lower + 1.0) for lim in limits]
+    assert call(ros, "set_soft_limit_joint", srv.SetSoftLimitJoint,
+                soft_limit=new).return_id.id == 0
+    got = call(ros, "get_soft_limit_joint", srv.GetSoftLimitJoint).soft_limit
+    assert got[1].upper == pytest.approx(119.0, abs=1e-3)
+    bad = list(new)
+    bad[2] = LimitValue(upper=-10.0, lower=10.0)
+    r = call(ros, "set_soft_limit_joint", srv.SetSoftLimitJoint, soft_limit=bad)
+    assert r.return_id.id == -3 and "below lower" in r.return_id.comment
+    speed = call(ros, "get_max_speed_cartesian", srv.GetMaxSpeedCartesian).speed
+    assert (speed.translation, speed.rotation) == (500.0, 90.0)
+    pos = call(ros, "get_feedback_pos_cartesian", srv.GetFeedbackPosCartesian).pos
+    assert pos.car_pos[3] == pytest.approx(163.0, abs=0.5) and len(pos.car_pos) == 12
+    assert call(ros, "get_active_alarm", srv.GetActiveAlarm).alarms == []
+
+
+@pytest.mark.parametrize("name, srv_type, fields, code", [
+    ("move_linear_cartesian_abs", srv.MoveLinearCartesianAbs,
+     dict(car_point=CarPosWithElbow(car_pos=[math.nan] + IDENTITY[1:])), -3),
+    ("move_ptp_cartesian_rel", srv.MovePTPCartesianRel, dict(car_point=rel(dx=5000.0)), -3),
+    ("move_ptp_joint_rel", srv.MovePTPJointRel, dict(joint_points=[1.0] * 3), -3),
+    ("move_gripper", srv.MoveGripper, dict(angle_ratio=150), -3),
+    ("set_base_offset", srv.SetBaseOffset, dict(offset=[2.0] + IDENTITY[1:]), -3),
+    ("set_control_point_offset", srv.SetControlPointOffset, dict(offset=[2.0] + IDENTITY[1:]), -1),
+    ("set_accel_time_joint", srv.SetAccelTimeJoint, dict(acl_time=math.inf), -3),
+    ("set_speed_cartesian", srv.SetSpeedCartesian, dict(spd_ratio=101), -3),
+])
+def test_bad_inputs_answer_the_right_id_and_the_node_stays_up(ros, arm_node, name, srv_type,
+                                                               fields, code):
+    ready(ros)
+    r = call(ros, name, srv_type, **fields)
+    assert r.return_id.id == code and r.return_id.comment
+    assert arm_node.alive()
+
+
+def test_service_move_then_wait_motion_with_feedback(ros, arm_node, wait_motion):
+    ready(ros)
+    start = call(ros, "get_feedback_pos_cartesian", srv.GetFeedbackPosCartesian).pos.car_pos
+    r = call(ros, "move_linear_cartesian_rel", srv.MoveLinearCartesianRel,
+             car_point=rel(dx=100.0, dz=-150.0))
+    assert r.return_id.id == 0 and r.motion_id > 0
+    feedback = []
+    handle = wait_motion.send(lambda f: feedback.append(f.feedback), motion_id=r.motion_id)
+    status, result = wait_motion.result(handle)
+    assert status == GoalStatus.STATUS_SUCCEEDED and result.completed
+    assert result.motion_id == r.motion_id
+    assert feedback and feedback[-1].current_label == "move_linear_cartesian_rel"
+    time.sleep(0.1)
+    end = call(ros, "get_feedback_pos_cartesian", srv.GetFeedbackPosCartesian).pos.car_pos
+    assert end[3] - start[3] == pytest.approx(100.0, abs=0.1)
+    assert end[11] - start[11] == pytest.approx(-150.0, abs=0.1)
+    handle = wait_motion.send(motion_id=r.motion_id + 100)
+    status, result = wait_motion.result(handle)
+    assert status == GoalStatus.STATUS_ABORTED and result.return_id.id == -3
+
+
+def test_move_action_runs_one_move_and_reports_where_it_ended(ros, arm_node, move):
+    ready(ros)
+    target = [10.0, 40.0, -10.0, -80.0, 20.0, 50.0, 30.0]
+    feedback = []
+    handle = move.send(lambda f: feedback.append(f.feedback), kind=Move.Goal.PTP_JOINT_ABS,
+                       joint_points=target)
+    status, result = move.result(handle)
+    assert status == GoalStatus.STATUS_SUCCEEDED and result.completed
+    assert result.return_id.id == 0 and feedback
+    assert max(abs(a - b) for a, b in zip(result.joint_pos[:7], target)) < 0.05
+    status, result = move.result(move.send(kind=Move.Goal.GRIPPER, angle_ratio=50))
+    assert result.completed and result.joint_pos[7] == pytest.approx(40.0, abs=1.0)
+    status, result = move.result(move.send(kind="fly"))
+    assert status == GoalStatus.STATUS_ABORTED and result.return_id.id == -3
+    assert "move_ptp_joint_abs" in result.return_id.comment
+
+
+def test_canceling_a_move_stops_the_arm(ros, arm_node, move):
+    ready(ros)
+    call(ros, "set_speed_joint", srv.SetSpeedJoint, spd_ratio=10)
+    feedback = []
+    handle = move.send(lambda f: feedback.append(f.feedback), kind=Move.Goal.PTP_JOINT_REL,
+                       joint_points=[60.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    deadline = time.monotonic() + 30.0
+    while not feedback and time.monotonic() < deadline:
+        ros.executor.spin_once(timeout_sec=0.1)
+    assert feedback
+    move.spin(handle.cancel_goal_async())
+    status, result = move.result(handle)
+    assert status == GoalStatus.STATUS_CANCELED and not result.completed
+    state = call(ros, "get_state", srv.GetState).state
+    assert state & 0x02 == 0 and state & 0x01
+
+
+def test_state_topic(ros, arm_node):
+    got = []
+    sub = ros.node.create_subscription(ArmState, ARM + "state", got.append, 10)
+    deadline = time.monotonic() + 20.0
+    while not got and time.monotonic() < deadline:
+        ros.executor.spin_once(timeout_sec=0.1)
+    ros.node.destroy_subscription(sub)
+    assert got
+    msg = got[-1]
+    assert msg.state & 0x01 and msg.queue_length == 0 and list(msg.alarms) == []
+    assert 0.0 < msg.position[2] < 2.0                      # metres
+    assert sum(x * x for x in msg.orientation) == pytest.approx(1.0)
+
+
+def test_pause_resume_and_queue_full_over_dds(ros, arm_node, wait_motion):
+    ready(ros)
+    call(ros, "set_speed_joint", srv.SetSpeedJoint, spd_ratio=20)
+    ids = [call(ros, "move_ptp_joint_rel", srv.MovePTPJointRel, joint_points=[8.0] * 7).motion_id]
+    assert wait_until(lambda: call(ros, "get_state", srv.GetState).state & 0x02, 10.0)
+    assert call(ros, "pause", srv.Pause).return_id.id == 0
+    assert wait_until(lambda: call(ros, "get_state", srv.GetState).state & 0x12 == 0x10, 10.0)
+    while True:                                   # queue_size 4: the fifth is refused
+        r = call(ros, "move_ptp_joint_rel", srv.MovePTPJointRel, joint_points=[-2.0] * 7)
+        if r.return_id.id == -5:
+            break
+        assert r.return_id.id == 0 and len(ids) < 5
+        ids.append(r.motion_id)
+    assert len(ids) == 5 and "full" in r.return_id.comment
+    assert call(ros, "get_state", srv.GetState).state == 0x19     # servo on, full, paused
+    assert call(ros, "resume", srv.Resume).return_id.id == 0
+    status, result = wait_motion.result(wait_motion.send(motion_id=0))
+    assert status == GoalStatus.STATUS_SUCCEEDED and result.completed
+    assert result.motion_id == ids[-1]

@@ -1,0 +1,68 @@
+"""Pinocchio kinematics of the SRS arm: IK round trips, the arm angle, reach, branch choice."""
+import math
+
+import numpy as np
+import pytest
+
+from acti_motion.arm import shared_kinematics
+from acti_motion.kinematics import Unreachable, wrap
+
+START = np.radians([0.0, 30.0, 0.0, -60.0, 0.0, 60.0, 0.0])
+
+
+@pytest.fixture(scope="module")
+def kin():
+    return shared_kinematics()
+
+
+def test_geometry_is_read_off_the_urdf(kin):
+    assert np.allclose(kin.shoulder, [0.10, 0.0, 0.54])
+    assert (kin.upper_arm, kin.forearm, kin.hand) == pytest.approx((0.4, 0.4, 0.126))
+
+
+def test_ik_reproduces_random_postures_with_their_arm_angle(kin):
+    rng = np.random.default_rng(7)
+    for _ in range(300):
+        q = rng.uniform(kin.lower * 0.95, kin.upper * 0.95)
+        got = kin.solve(kin.flange(q), q + rng.normal(0.0, 0.03, 7), psi=kin.arm_angle(q))
+        assert np.max(np.abs(got - q)) < 1e-6
+
+
+@pytest.mark.parametrize("psi_deg", [-150.0, -60.0, 0.0, 45.0, 120.0, 180.0])
+def test_ik_honours_the_arm_angle_and_keeps_the_pose(kin, psi_deg):
+    target = kin.flange(START)
+    q = kin.solve(target, START, psi=math.radians(psi_deg))
+    assert np.allclose(kin.flange(q), target, atol=1e-9)
+    assert abs(wrap(kin.arm_angle(q) - math.radians(psi_deg))) < 1e-8
+
+
+def test_start_posture_reports_elbow_zero_and_flags(kin):
+    assert math.degrees(kin.arm_angle(START)) == pytest.approx(0.0, abs=1e-9)
+    assert kin.flags(START) == 0
+    assert kin.flags(np.radians([0, -30, 0, 60, 0, -60, 0])) == 0x7
+
+
+def test_unreachable_targets_say_why(kin):
+    far = kin.flange(START)
+    far[:3, 3] = kin.shoulder + [1.2, 0.0, 0.0]
+    with pytest.raises(Unreachable, match="out of reach"):
+        kin.solve(far, START)
+    near = kin.flange(START)
+    near[:3, 3] = kin.shoulder + near[:3, 2] * kin.hand + [0.05, 0.0, 0.0]
+    with pytest.raises(Unreachable, match="too close"):
+        kin.solve(near, START)
+
+
+def test_soft_joint_limits_restrict_the_solutions(kin):
+    target = kin.flange(START)
+    lower, upper = kin.lower.copy(), kin.upper.copy()
+    lower[5] = math.radians(70.0)          # J6 must be >= 70°, but this pose needs 60° or -60°
+    with pytest.raises(Unreachable, match="joint limits"):
+        kin.solve(target, START, psi=0.0, lower=lower, upper=upper)
+
+
+def test_transport_keeps_the_elbow_normal_to_the_new_line(kin):
+    u0, n0 = kin.elbow_direction(START)
+    u1 = np.array([1.0, 0.0, 1.0]) / math.sqrt(2)
+    n1 = kin.transport(n0, u0, u1)
+    assert abs(np.dot(n1, u1)) < 1e-12 and np.linalg.norm(n1) == pytest.approx(1.0)
