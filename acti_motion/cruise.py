@@ -15,7 +15,6 @@ from dataclasses import dataclass
 from typing import Sequence
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from acti_motion.base import (Chain, CurvePath, Odometry, Path, Pose2D, SampledPath,
                               TrackedBaseMotion, straight_to, turn, velocity_path, wrap_angle)
@@ -72,6 +71,7 @@ def spline_through(start: Pose2D, points: Sequence[tuple[float, float]]):
     """Dense samples of the cubic spline from the start position through `points`, leaving along
     the start heading: (arc length s, x, y, heading, arc length of each point); None if no point
     is farther than MIN_SEPARATION from the one before."""
+    from scipy.interpolate import CubicSpline  # noqa: PLC0415 - lazy, like toppra (0.3 s)
     xy = [(start.x, start.y)]
     index = []                                   # per given point: its row in xy
     for p in points:
