@@ -169,3 +169,37 @@ def test_joystick_over_the_joy_topic(ros, vehicle):
         ros.node.destroy_subscription(sub)
         ros.node.destroy_publisher(joy)
     assert vehicle.alive()
+
+
+def test_wait_motion_action(ros, vehicle):
+    from acti_msgs.action import VehicleWaitMotion
+    from rclpy.action import ActionClient
+    client = ActionClient(ros.node, VehicleWaitMotion, BASE + "wait_motion")
+    try:
+        assert client.wait_for_server(timeout_sec=10.0)
+        assert call(ros, "set_power", on_off=True).success and call(ros, "set_servo", on_off=True).success
+        assert wait_until(lambda: state(ros) == 0x010, 10.0)
+        start = call(ros, "get_position").pos
+        motion_id = call(ros, "move_forward", x=400.0).motion_id
+        feedback = []
+        goal = client.send_goal_async(VehicleWaitMotion.Goal(motion_id=motion_id, timeout=20.0),
+                                      feedback_callback=lambda f: feedback.append(f.feedback))
+        ros.executor.spin_until_future_complete(goal, timeout_sec=5.0)
+        assert goal.result().accepted
+        result_future = goal.result().get_result_async()
+        ros.executor.spin_until_future_complete(result_future, timeout_sec=20.0)
+        result = result_future.result().result
+        assert result.success and result.completed and result.motion_id == motion_id
+        moved = math.hypot(result.pos.x - start.x, result.pos.y - start.y)
+        assert abs(moved - 400.0) < 5.0
+        assert feedback and feedback[-1].current_motion_id == motion_id
+        assert feedback[-1].current_label == "move_forward"
+        bad = client.send_goal_async(VehicleWaitMotion.Goal(motion_id=motion_id + 100))
+        ros.executor.spin_until_future_complete(bad, timeout_sec=5.0)
+        result_future = bad.result().get_result_async()
+        ros.executor.spin_until_future_complete(result_future, timeout_sec=5.0)
+        result = result_future.result().result
+        assert not result.success and "never queued" in result.message
+    finally:
+        client.destroy()
+    assert vehicle.alive()
