@@ -77,8 +77,8 @@ def test_every_operation_is_a_service_plus_actions_and_state(ros, arm_node):
     for op in OPERATIONS:
         want = op.srv_type.__module__.split(".")[0] + "/srv/" + op.srv_type.__name__
         assert services.get(ARM + op.name) == [want], op.name
-    topics = dict(ros.node.get_topic_names_and_types())
-    assert topics[ARM + "state"] == ["acti_msgs/msg/ArmState"]
+    assert wait_until(lambda: ARM + "state" in dict(ros.node.get_topic_names_and_types()), 30.0)
+    assert dict(ros.node.get_topic_names_and_types())[ARM + "state"] == ["acti_msgs/msg/ArmState"]
 
 
 def test_nested_messages_both_ways(ros, arm_node):
