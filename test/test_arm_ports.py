@@ -350,3 +350,14 @@ def test_settings_refused_while_moving(arm, executor):  # noqa: F811
     r = arm.set_control_point_offset(IDENTITY)
     assert r.code == R.STATUS_ERR
     assert arm.set_base_offset(IDENTITY).ok          # the spec lists no STATUS_ERR for it
+
+
+@pytest.mark.parametrize("field, value", [
+    ("queue_size", 0), ("initial_speed_ratio", 101), ("accel_time_joint", 0.0),
+    ("max_speed_translation", NAN), ("soft_limit_cartesian", (1.0, 0.0, 0, 1, 0, 1)),
+    ("soft_limit_cartesian", (0.0, 1.0)), ("initial_joints_deg", (0.0,) * 6),
+    ("home_joints_deg", (0.0, 200.0, 0, 0, 0, 0, 0)),
+])
+def test_bad_start_settings_are_refused_at_start(executor, field, value):  # noqa: F811
+    with pytest.raises(ValueError, match=field):
+        ArmCore(executor, ArmConfig(**{field: value}))
