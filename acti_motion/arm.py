@@ -397,8 +397,8 @@ class ArmCore:
         why = self._control_ignored()
         if why is None and self.device.paused:
             why = "already paused"
-        if why is None and self.device.current is None:
-            why = "the arm is not moving"
+        if why is None and (self.device.current is None or self.device.stopping):
+            why = "the arm is not moving" if self.device.current is None else "it is stopping"
         if why is not None:
             return _ignored(why)
         if not self.device.pause(self._current_ramp()):

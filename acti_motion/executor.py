@@ -75,6 +75,11 @@ class Device:
         return self.current is not None or bool(self.queue)
 
     @property
+    def stopping(self) -> bool:
+        """A stop is decelerating the current motion."""
+        return self._stop_at is not None
+
+    @property
     def queue_length(self) -> int:
         return len(self.queue)
 

@@ -243,6 +243,17 @@ def test_stop_while_paused_flushes_and_clears_the_pause(arm, executor):  # noqa:
     assert arm.state_word() == 0x01
 
 
+def test_pause_while_stopping_is_ignored(arm, executor):  # noqa: F811
+    assert arm.move_ptp_joint_rel([20.0] * 7).ok
+    run_until(executor, lambda: executor.world.time > 0.5, 2.0)
+    assert arm.stop().ok
+    assert arm.pause().comment == "ignored: it is stopping"
+    run_until(executor, lambda: not arm.device.busy, 1.0)
+    assert arm.state_word() == 0x01
+    assert arm.move_ptp_joint_rel([1.0] * 7).ok
+    assert run_until(executor, lambda: not arm.device.busy, 2.0) > 0.2
+
+
 # --- gripper -------------------------------------------------------------------------------------------------
 def test_gripper_commands_queue_in_order_with_the_moves(arm, executor):  # noqa: F811
     assert arm.move_ptp_joint_rel([10.0] * 7).ok
