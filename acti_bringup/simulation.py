@@ -2,6 +2,7 @@
 topics that belong to the world as a whole (/clock and joint_states)."""
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 
 import rclpy
@@ -14,6 +15,8 @@ from sensor_msgs.msg import JointState
 from acti_bringup.parameters import declare_config
 from acti_motion.executor import MotionExecutor
 from acti_sim.world import World
+
+SWITCH_INTERVAL_S = 2e-4
 
 
 @dataclass
@@ -33,6 +36,9 @@ class Simulation:
 
     def __init__(self, node: Node) -> None:
         self.config = c = declare_config(node, SimulationConfig)
+        # Service threads wait for the GIL while the simulation thread computes; a short switch
+        # interval bounds that wait (the default 5 ms would dominate every round trip).
+        sys.setswitchinterval(SWITCH_INTERVAL_S)
         if c.rate_hz <= 0 or c.real_time_factor < 0 or c.joint_state_rate_hz <= 0:
             raise ValueError("rate_hz and joint_state_rate_hz must be > 0, real_time_factor >= 0")
         self.world = World(time_step=1.0 / c.rate_hz)

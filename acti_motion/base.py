@@ -1,12 +1,20 @@
-"""Differential-drive base: wheel odometry and pose-tracking motions (SI units: m, rad, s)."""
+"""Differential-drive base: wheel odometry, reference paths and pose-tracking motions (SI: m, rad, s).
+
+A *path* is a reference in its own time from 0: `duration`, `pose(t)` (odometry frame) and
+`twist(t)` = (forward speed, yaw rate). A `TrackedBaseMotion` follows one on the odometry with
+Kanayama's tracking law; while it runs, the rest of its path can be replaced (`splice`), which is
+how a jog, a continuous move or a cruise take a new target without stopping.
+"""
 from __future__ import annotations
 
+import bisect
 import math
+import threading
 from dataclasses import dataclass
+from typing import Protocol, Sequence
 
 import numpy as np
 
-from acti_motion.profiles import Trapezoid
 from acti_sim.world import World
 
 
@@ -20,6 +28,19 @@ class Pose2D:
         return Pose2D(self.x + distance * math.cos(self.theta),
                       self.y + distance * math.sin(self.theta), self.theta)
 
+    def compose(self, rel: "Pose2D") -> "Pose2D":
+        """`rel`, given in this pose's frame, in the frame this pose is given in."""
+        c, s = math.cos(self.theta), math.sin(self.theta)
+        return Pose2D(self.x + c * rel.x - s * rel.y, self.y + s * rel.x + c * rel.y,
+                      self.theta + rel.theta)
+
+    def inverse(self) -> "Pose2D":
+        c, s = math.cos(self.theta), math.sin(self.theta)
+        return Pose2D(-c * self.x - s * self.y, s * self.x - c * self.y, -self.theta)
+
+    def distance(self, other: "Pose2D") -> float:
+        return math.hypot(other.x - self.x, other.y - self.y)
+
 
 def wrap_angle(a: float) -> float:
     return (a + math.pi) % (2 * math.pi) - math.pi
@@ -28,7 +49,7 @@ def wrap_angle(a: float) -> float:
 class Odometry:
     """Dead reckoning from wheel rotation, as a real base would have it (not the ground truth).
 
-    `origin` redefines where the odometry frame is (setPosition).
+    `reset` redefines the pose (setPosition); `lock` makes a reset atomic with the updates.
     """
 
     def __init__(self, wheel_radius: float, wheel_separation: float, wheels: np.ndarray) -> None:
@@ -37,66 +58,342 @@ class Odometry:
         self.pose = Pose2D(0.0, 0.0, 0.0)
         self.v = 0.0
         self.w = 0.0
+        self.lock = threading.Lock()
 
     def update(self, wheels: np.ndarray, dt: float) -> None:
         dl, dr = (wheels - self._last) * self.r
         self._last = wheels.copy()
         ds, dth = (dl + dr) / 2, (dr - dl) / self.b
-        p = self.pose
-        mid = p.theta + dth / 2
-        self.pose = Pose2D(p.x + ds * math.cos(mid), p.y + ds * math.sin(mid),
-                           wrap_angle(p.theta + dth))
+        with self.lock:
+            p = self.pose
+            mid = p.theta + dth / 2
+            self.pose = Pose2D(p.x + ds * math.cos(mid), p.y + ds * math.sin(mid),
+                               wrap_angle(p.theta + dth))
         self.v, self.w = ds / dt, dth / dt
 
-    def reset(self, pose: Pose2D) -> None:
-        self.pose = pose
+    def reset(self, pose: Pose2D) -> Pose2D:
+        """Redefine the pose; returns the transform from the old frame to the new one."""
+        with self.lock:
+            old, self.pose = self.pose, pose
+        return pose.compose(old.inverse())
 
 
+# --- paths -----------------------------------------------------------------------------------
+class Path(Protocol):
+    duration: float
+
+    def pose(self, t: float) -> Pose2D:
+        """Reference pose at t (clamped to [0, duration])."""
+
+    def twist(self, t: float) -> tuple[float, float]:
+        """(forward speed m/s, yaw rate rad/s) at t; (0, 0) outside [0, duration]."""
+
+
+class Ramp:
+    """Time-optimal 1-D profile over `length` >= 0 from speed `v0` >= 0 to rest: accelerate (or
+    decelerate) to `vmax`, cruise, decelerate, all at `amax`. A start too fast to stop within
+    `length` decelerates harder, just enough."""
+
+    def __init__(self, length: float, vmax: float, amax: float, v0: float = 0.0) -> None:
+        self.length = length = max(0.0, length)
+        self.segments: list[tuple[float, float, float, float]] = []   # (t0, s0, v0, a)
+        t = s = 0.0
+        v = max(0.0, v0)
+
+        def push(a: float, dt: float) -> None:
+            nonlocal t, s, v
+            if dt > 0.0:
+                self.segments.append((t, s, v, a))
+                s += v * dt + a * dt * dt / 2
+                v += a * dt
+                t += dt
+        if length <= 0.0:
+            self.duration = 0.0
+            self.segments.append((0.0, 0.0, 0.0, 0.0))
+            self._starts = [0.0]
+            return
+        if v * v / (2 * amax) >= length:                  # cannot stop in time: brake harder
+            push(-v * v / (2 * length), 2 * length / v)
+        else:
+            peak = min(vmax, math.sqrt(amax * length + v * v / 2)) if v <= vmax else vmax
+            d_change = abs(peak * peak - v * v) / (2 * amax)
+            d_stop = peak * peak / (2 * amax)
+            push(math.copysign(amax, peak - v), abs(peak - v) / amax)
+            push(0.0, max(0.0, length - d_change - d_stop) / peak)
+            push(-amax, peak / amax)
+        self.duration = t
+        self.segments.append((t, length, 0.0, 0.0))
+        self._starts = [seg[0] for seg in self.segments]
+
+    def sample(self, t: float) -> tuple[float, float]:
+        """(s, ds/dt) at t, clamped to the ends."""
+        if t >= self.duration:
+            return self.length, 0.0
+        if t <= 0.0:
+            return 0.0, self.segments[0][2]
+        t0, s0, v0, a = self.segments[bisect.bisect_right(self._starts, t) - 1]
+        dt = t - t0
+        return s0 + v0 * dt + a * dt * dt / 2, v0 + a * dt
+
+
+class CurvePath:
+    """A curve of constant shape driven by a `Ramp` on its parameter s: a straight line (s in m),
+    a turn in place (s in rad) or an arc about a point (s in rad of rotation about it).
+
+    `unit` = (forward speed, yaw rate) per unit ds/dt, signed; the curve is the rigid motion
+    generated by that body twist from `start`.
+    """
+
+    def __init__(self, start: Pose2D, unit: tuple[float, float], length: float,
+                 limits: tuple[float, float, float, float], v0: float = 0.0) -> None:
+        """`limits` = (v_max, w_max, a_max, alpha_max) of the base; `v0` the start ds/dt."""
+        self.start, self.unit = start, unit
+        u_v, u_w = abs(unit[0]), abs(unit[1])
+        v_max, w_max, a_max, alpha_max = limits
+        sd_max = min(v_max / u_v if u_v > 0 else math.inf, w_max / u_w if u_w > 0 else math.inf)
+        sdd_max = min(a_max / u_v if u_v > 0 else math.inf, alpha_max / u_w if u_w > 0 else math.inf)
+        self.ramp = Ramp(length, sd_max, sdd_max, v0)
+        self.duration = self.ramp.duration
+
+    def at_parameter(self, s: float) -> Pose2D:
+        v, w = self.unit[0] * s, self.unit[1] * s
+        if abs(w) < 1e-12:
+            return self.start.forward(v)
+        r = v / w                                         # the body twist integrated exactly
+        return self.start.compose(Pose2D(r * math.sin(w), r * (1 - math.cos(w)), w))
+
+    def pose(self, t: float) -> Pose2D:
+        return self.at_parameter(self.ramp.sample(t)[0])
+
+    def twist(self, t: float) -> tuple[float, float]:
+        if t < 0.0 or t >= self.duration:
+            return 0.0, 0.0
+        sd = self.ramp.sample(t)[1]
+        return self.unit[0] * sd, self.unit[1] * sd
+
+
+def line(start: Pose2D, distance: float, limits: tuple[float, float, float, float]) -> CurvePath:
+    """Straight `distance` m along the heading (negative: backwards)."""
+    return CurvePath(start, (math.copysign(1.0, distance), 0.0), abs(distance), limits)
+
+
+def turn(start: Pose2D, angle: float, limits: tuple[float, float, float, float]) -> CurvePath:
+    """Turn in place by `angle` rad, counter-clockwise positive."""
+    return CurvePath(start, (0.0, math.copysign(1.0, angle)), abs(angle), limits)
+
+
+def arc(start: Pose2D, centre_y: float, angle: float,
+        limits: tuple[float, float, float, float]) -> CurvePath:
+    """Rotate the base rigidly by `angle` rad about the point `centre_y` m to its left (on the
+    wheel axle): forward speed = centre_y · yaw rate."""
+    sign = math.copysign(1.0, angle)
+    return CurvePath(start, (centre_y * sign, sign), abs(angle), limits)
+
+
+class Chain:
+    """Paths one after the other (each starts where the previous one ends, at rest)."""
+
+    def __init__(self, paths: Sequence[Path], start: Pose2D) -> None:
+        self.paths = [p for p in paths if p.duration > 0.0]
+        self.start = start
+        self.starts = list(np.cumsum([0.0] + [p.duration for p in self.paths]))
+        self.duration = self.starts[-1]
+
+    def _find(self, t: float) -> tuple[Path | None, float]:
+        if not self.paths:
+            return None, 0.0
+        i = min(max(bisect.bisect_right(self.starts, t) - 1, 0), len(self.paths) - 1)
+        return self.paths[i], t - self.starts[i]
+
+    def pose(self, t: float) -> Pose2D:
+        path, tau = self._find(t)
+        return self.start if path is None else path.pose(tau)
+
+    def twist(self, t: float) -> tuple[float, float]:
+        if t < 0.0 or t >= self.duration:
+            return 0.0, 0.0
+        path, tau = self._find(t)
+        return path.twist(tau)
+
+
+class Moved:
+    """A path seen from another frame: pose' = frame ∘ pose (setPosition moves the odometry frame)."""
+
+    def __init__(self, path: Path, frame: Pose2D) -> None:
+        self.path, self.frame = path, frame
+        self.duration = path.duration
+
+    def pose(self, t: float) -> Pose2D:
+        return self.frame.compose(self.path.pose(t))
+
+    def twist(self, t: float) -> tuple[float, float]:
+        return self.path.twist(t)
+
+
+def straight_to(start: Pose2D, goal: Pose2D, limits: tuple[float, float, float, float],
+                wrap_final: bool) -> Chain:
+    """A differential drive's straight move: turn toward the goal, drive, turn to its heading.
+    A goal behind the base is reached backwards (the smaller turn). `wrap_final` turns the
+    shorter way to an absolute heading; otherwise the heading change is taken as given."""
+    dx, dy = goal.x - start.x, goal.y - start.y
+    dist = math.hypot(dx, dy)
+    paths: list[Path] = []
+    here = start
+    if dist > 1e-5:
+        bearing = wrap_angle(math.atan2(dy, dx) - start.theta)
+        if abs(bearing) > math.pi / 2:
+            bearing, dist = wrap_angle(bearing - math.pi), -dist
+        paths.append(turn(here, bearing, limits))
+        here = Pose2D(here.x, here.y, here.theta + bearing)
+        paths.append(line(here, dist, limits))
+        here = here.forward(dist)
+    final = goal.theta - here.theta
+    paths.append(turn(here, wrap_angle(final) if wrap_final else final, limits))
+    return Chain(paths, start)
+
+
+class SampledPath:
+    """A path given as samples (t, x, y, theta, v, w), linearly interpolated (theta unwrapped)."""
+
+    def __init__(self, t: np.ndarray, x: np.ndarray, y: np.ndarray, theta: np.ndarray,
+                 v: np.ndarray, w: np.ndarray) -> None:
+        self.t, self.x, self.y, self.theta, self.v, self.w = t, x, y, theta, v, w
+        self.duration = float(t[-1])
+
+    def _index(self, t: float) -> tuple[int, float]:
+        i = min(max(int(np.searchsorted(self.t, t, side="right")) - 1, 0), len(self.t) - 2)
+        span = self.t[i + 1] - self.t[i]
+        return i, 0.0 if span <= 0 else min(1.0, max(0.0, (t - self.t[i]) / span))
+
+    def pose(self, t: float) -> Pose2D:
+        if len(self.t) == 1:
+            return Pose2D(float(self.x[0]), float(self.y[0]), float(self.theta[0]))
+        i, f = self._index(t)
+        lerp = lambda a: float(a[i] + f * (a[i + 1] - a[i]))  # noqa: E731
+        return Pose2D(lerp(self.x), lerp(self.y), lerp(self.theta))
+
+    def twist(self, t: float) -> tuple[float, float]:
+        if t < 0.0 or t >= self.duration or len(self.t) == 1:
+            return 0.0, 0.0
+        i, f = self._index(t)
+        return (float(self.v[i] + f * (self.v[i + 1] - self.v[i])),
+                float(self.w[i] + f * (self.w[i + 1] - self.w[i])))
+
+
+def velocity_path(start: Pose2D, v0: float, w0: float, target: tuple[float, float], hold: float,
+                  accel: tuple[float, float], dt: float = 0.005) -> SampledPath:
+    """Drive like a jog: from speed (v0, w0) slew to `target` (v, w) at `accel` (a, alpha), keep it
+    until `hold` s, then slew to rest. With hold = 0 and target (0, 0) it is a brake."""
+    a, alpha = accel
+    ts, xs, ys, ths, vs, ws = [0.0], [start.x], [start.y], [start.theta], [v0], [w0]
+    t, x, y, th, v, w = 0.0, start.x, start.y, start.theta, v0, w0
+
+    def slew(cur: float, goal: float, rate: float) -> float:
+        step = rate * dt
+        return goal if abs(goal - cur) <= step else cur + math.copysign(step, goal - cur)
+    limit = hold + abs(v0) / a + abs(w0) / alpha + abs(target[0]) / a + abs(target[1]) / alpha + 1.0
+    while t < limit:
+        goal = target if t < hold else (0.0, 0.0)
+        if t >= hold and v == 0.0 and w == 0.0:
+            break
+        v1, w1 = slew(v, goal[0], a), slew(w, goal[1], alpha)
+        vm, wm = (v + v1) / 2, (w + w1) / 2
+        mid = th + wm * dt / 2
+        x, y, th = x + vm * dt * math.cos(mid), y + vm * dt * math.sin(mid), th + wm * dt
+        t += dt
+        v, w = v1, w1
+        ts.append(t)
+        xs.append(x)
+        ys.append(y)
+        ths.append(th)
+        vs.append(v)
+        ws.append(w)
+    return SampledPath(*(np.array(a_) for a_ in (ts, xs, ys, ths, vs, ws)))
+
+
+# --- motions ---------------------------------------------------------------------------------
 class TrackedBaseMotion:
     """A base motion along a reference path: feed-forward twist plus feedback on the odometry
-    error (Kanayama's tracking law), then a short settle so the base ends on the target."""
+    error (Kanayama's tracking law), then a short settle so the base ends on the target.
+
+    The path runs from motion time `t0`; `splice(t, path)` makes `path` the reference from t on.
+    `error` is the latest tracking error (m, rad), for blocked-base detection.
+    """
 
     SETTLE = 0.4
     K_X, K_Y, K_TH = 3.0, 30.0, 6.0
 
-    def __init__(self, odometry: Odometry, reference: "LinePath") -> None:
+    def __init__(self, odometry: Odometry, path: Path, kind: str = "") -> None:
         self.odometry = odometry
-        self.reference = reference
-        self.duration = reference.duration + self.SETTLE
+        self.path = path
+        self.t0 = 0.0
+        self.kind = kind
+        self.error = (0.0, 0.0)
+
+    @property
+    def duration(self) -> float:
+        return self.t0 + self.path.duration + self.SETTLE
+
+    @property
+    def path_end(self) -> float:
+        """Motion time at which the reference stops (the settle follows)."""
+        return self.t0 + self.path.duration
 
     def at(self, t: float) -> Pose2D:
-        return self.reference.pose(min(t, self.reference.duration))
+        return self.path.pose(min(max(t - self.t0, 0.0), self.path.duration))
+
+    def reference_twist(self, t: float) -> tuple[float, float]:
+        return self.path.twist(t - self.t0)
+
+    def splice(self, t: float, path: Path) -> None:
+        """Follow `path` (which starts at the reference state at t) from motion time t on; what
+        came before t is never asked for again (the device only looks ahead)."""
+        self.path, self.t0 = path, t
+
+    def move_frame(self, frame: Pose2D) -> None:
+        self.path = Moved(self.path, frame)
 
     def apply(self, world: World, t: float, rate: float) -> None:
         if t >= self.duration:
             world.set_wheel_velocities(0.0, 0.0)
             return
         ref = self.at(t)
-        v_d, w_d = self.reference.twist(t) if t < self.reference.duration else (0.0, 0.0)
+        v_d, w_d = self.reference_twist(t)
         v_d, w_d = v_d * rate, w_d * rate
         p = self.odometry.pose
         dx, dy = ref.x - p.x, ref.y - p.y
         ex = math.cos(p.theta) * dx + math.sin(p.theta) * dy
         ey = -math.sin(p.theta) * dx + math.cos(p.theta) * dy
         eth = wrap_angle(ref.theta - p.theta)
+        self.error = (math.hypot(ex, ey), eth)
         v = v_d * math.cos(eth) + self.K_X * ex
         w = w_d + v_d * self.K_Y * ey + self.K_TH * math.sin(eth)
         r, b = self.odometry.r, self.odometry.b
         world.set_wheel_velocities((v - w * b / 2) / r, (v + w * b / 2) / r)
 
 
-class LinePath:
-    """Straight line from `start` by `distance` (m; negative drives backwards), trapezoid-timed."""
+class BrakeMotion:
+    """Stop the wheels from their measured speeds at the given decelerations, without a reference
+    pose (after a contact or a blockage); the set-point is wherever odometry says the base is."""
 
-    def __init__(self, start: Pose2D, distance: float, speed: float, accel: float) -> None:
-        self.start, self.distance = start, distance
-        self.profile = Trapezoid.for_axes(np.array([distance]), np.array([speed]), speed / accel)
-        self.duration = self.profile.duration
+    SETTLE = 0.1
 
-    def pose(self, t: float) -> Pose2D:
-        s, _ = self.profile.sample(t)
-        return self.start.forward(s * self.distance)
+    def __init__(self, odometry: Odometry, decel: tuple[float, float]) -> None:
+        self.odometry = odometry
+        self.kind = "brake"
+        self.v0, self.w0 = odometry.v, odometry.w
+        self.ramp = max(abs(self.v0) / decel[0], abs(self.w0) / decel[1], 1e-3)
+        self.duration = self.ramp + self.SETTLE
+        self.error = (0.0, 0.0)
 
-    def twist(self, t: float) -> tuple[float, float]:
-        _, ds = self.profile.sample(t)
-        return ds * self.distance, 0.0
+    def at(self, t: float) -> Pose2D:
+        return self.odometry.pose
+
+    def move_frame(self, frame: Pose2D) -> None:
+        """Nothing to move: the set-point is the odometry itself."""
+
+    def apply(self, world: World, t: float, rate: float) -> None:
+        k = max(0.0, 1.0 - t / self.ramp)
+        v, w = self.v0 * k, self.w0 * k
+        r, b = self.odometry.r, self.odometry.b
+        world.set_wheel_velocities((v - w * b / 2) / r, (v + w * b / 2) / r)

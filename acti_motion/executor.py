@@ -149,6 +149,40 @@ class Device:
             self._set_rate(0.0, ramp)
             self.queued_end = cur.motion.at(self._stop_at)
 
+    @property
+    def stopping(self) -> bool:
+        return self._stop_at is not None
+
+    def edit(self, fn: Callable[["Device"], Any]) -> Any:
+        """Run fn(device) under the lock and return its result: a core changes its motions in place
+        there (the current one from time `t` on, queued ones whole, or the rest point `hold`)
+        without racing the simulation; the queued end then follows the last motion."""
+        with self.lock:
+            out = fn(self)
+            last = self.queue[-1] if self.queue else self.current
+            if last is None:
+                self.queued_end = self.hold
+            elif last is self.current and self._stop_at is not None:
+                self.queued_end = last.motion.at(self._stop_at)
+            else:
+                self.queued_end = last.motion.at(last.motion.duration)
+            self.changed.notify_all()
+            return out
+
+    def halt(self, rest: Any) -> None:
+        """Discard the current motion and the queue at once and rest at `rest` (where the device
+        is, as measured): for a device that cannot follow its plan (blocked, a contact)."""
+        with self.lock:
+            self.generation += 1
+            self._retire_queue()
+            if self.current is not None:
+                self._finish(discarded=True)
+            self._stop_at = None
+            self.paused = False
+            self.rate = self._rate_target = 1.0
+            self.hold = self.queued_end = rest
+            self.changed.notify_all()
+
     def wait(self, motion_id: int, timeout: float | None) -> bool:
         """Block until motion `motion_id` (0: everything queued now) is over; False on timeout."""
         deadline = None if timeout is None else time.monotonic() + timeout
@@ -288,7 +322,8 @@ class MotionExecutor:
         sim0 = self.world.time
         while self._running.is_set():
             self.step()
+            ahead = 0.0
             if self.real_time_factor > 0:
                 ahead = (self.world.time - sim0) / self.real_time_factor - (time.monotonic() - wall0)
-                if ahead > 0:
-                    time.sleep(ahead)
+            # Sleeping (even 0 s) hands the GIL to service threads once per step.
+            time.sleep(max(ahead, 0.0))

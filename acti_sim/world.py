@@ -44,8 +44,11 @@ class World:
         p.setGravity(0, 0, -9.81)
         p.setTimeStep(time_step)
         self.plane = p.loadURDF("plane.urdf")
+        # Implicit cylinders: by default PyBullet turns a URDF cylinder into a convex hull, on which
+        # the wheels roll ~2 % farther than 2πr per turn (and the base pitches): odometry was off.
         self.robot = p.loadURDF(urdf_path, [0, 0, 0.1], useFixedBase=False,
-                                flags=pybullet.URDF_USE_INERTIA_FROM_FILE)
+                                flags=pybullet.URDF_USE_INERTIA_FROM_FILE
+                                | pybullet.URDF_USE_IMPLICIT_CYLINDER)
         self._joint = {}
         self._link = {}
         self.limits: dict[str, JointLimit] = {}
@@ -58,9 +61,12 @@ class World:
         # Free all motors; every driven joint gets an explicit motor below.
         for j in self._joint.values():
             p.setJointMotorControl2(self.robot, j, pybullet.VELOCITY_CONTROL, force=0)
+        # Sprung casters: frictionless, and compliant so that the driven wheels carry the weight
+        # (rigid casters took ~90 % of it and the wheels slipped: odometry drifted in turns).
         for name in CASTER_LINKS:
             p.changeDynamics(self.robot, self._link[name], lateralFriction=0.0,
-                             rollingFriction=0.0, spinningFriction=0.0)
+                             rollingFriction=0.0, spinningFriction=0.0,
+                             contactStiffness=5.0e4, contactDamping=3.0e3)
         for name in WHEEL_JOINTS:
             p.changeDynamics(self.robot, self._joint[name], lateralFriction=1.5)
         self._arm_ids = [self._joint[n] for n in ARM_JOINTS]

@@ -1,54 +1,143 @@
-"""VehicleCore in the real simulation, without ROS: power/servo (table 8), state, move_forward."""
+"""VehicleCore motions in the real simulation, without ROS: straight, turn, circular moves end on
+target (odometry, and the ground truth agrees), the queue, pause/resume/stop."""
 import math
 
 import pytest
 
-from acti_motion.vehicle import VehicleCore, VehicleState
+from acti_motion.base import TrackedBaseMotion
+from acti_motion.vehicle import VehicleState
 from sim_fixtures import executor, run_until  # noqa: F401
+from vehicle_fixtures import assert_at, base, position, ready, settle, state, steps  # noqa: F401
 
 
-@pytest.fixture
-def base(executor):  # noqa: F811
-    return VehicleCore(executor)
+TRACKING_SETTLE = TrackedBaseMotion.SETTLE
 
 
-def state(base):
-    return base.get_state().values["state"]
-
-
-def test_power_and_servo_walk_through_the_state_table(base):
-    assert state(base) == VehicleState.UNPOWERED
-    r = base.set_servo(True)
-    assert not r.ok and "power" in r.comment           # table 8: power off → false
-    assert base.set_power(True).ok and state(base) == VehicleState.POWERED
-    assert base.set_servo(True).ok and state(base) == VehicleState.READY
-    assert base.set_servo(True).ok and state(base) == VehicleState.READY   # stays on
-    assert base.set_servo(False).ok and state(base) == VehicleState.POWERED
-    assert base.set_servo(False).ok and state(base) == VehicleState.POWERED
-    assert base.get_state().values["msg"] == "Powered"
-
-
-@pytest.mark.parametrize("x", [math.nan, math.inf, -math.inf])
-def test_move_forward_bad_distance(base, x):
-    base.set_power(True)
-    base.set_servo(True)
-    r = base.move_forward(x)
-    assert not r.ok and "finite" in r.comment
-    assert base.device.queue_length == 0
-
-
-def test_move_forward_needs_ready(base):
-    r = base.move_forward(100.0)
-    assert not r.ok and "Unpowered" in r.comment
+def truth_mm(executor):  # noqa: F811
+    x, y, th = executor.world.base_pose()
+    return 1000.0 * x, 1000.0 * y, math.degrees(th)
 
 
 @pytest.mark.parametrize("distance", [500.0, -300.0])
 def test_move_forward_ends_within_5_mm(base, executor, distance):  # noqa: F811
-    base.set_power(True)
-    base.set_servo(True)
+    ready(base)
+    x0 = truth_mm(executor)[0]
     assert base.move_forward(distance).ok
     assert state(base) == VehicleState.BUSY
-    run_until(executor, lambda: not base.device.busy, 10.0)
-    x, y, theta = base.get_position().values["pos"]
-    assert abs(x - distance) < 5.0 and abs(y) < 5.0 and abs(theta) < 0.5
+    settle(executor, base)
+    assert_at(base, distance, 0.0, 0.0)
     assert state(base) == VehicleState.READY
+    # wheel odometry agrees with the ground truth (true cylinders, sprung casters)
+    assert abs(truth_mm(executor)[0] - x0 - distance) < 2.0
+
+
+@pytest.mark.parametrize("angle", [90.0, -135.0, 400.0])
+def test_move_turn_counter_clockwise_positive(base, executor, angle):  # noqa: F811
+    ready(base)
+    assert base.move_turn(angle).ok
+    settle(executor, base)
+    assert_at(base, 0.0, 0.0, angle)
+    assert abs(math.remainder(truth_mm(executor)[2] - angle, 360.0)) < 0.5
+
+
+def test_move_linear_rel_then_abs_queue_and_stop_at_each(base, executor):  # noqa: F811
+    ready(base)
+    assert base.move_linear_rel((300.0, 400.0, -30.0)).ok
+    assert base.move_linear_abs((0.0, 600.0, 180.0)).ok          # servo-on: queues while Busy
+    rest = base.device.queue[1].motion
+    settle(executor, base)
+    assert_at(base, 0.0, 600.0, 180.0)
+    assert rest.path.twist(0.0) == (0.0, 0.0)                     # starts from rest
+    tx, ty, _ = truth_mm(executor)
+    assert math.hypot(tx, ty - 600.0) < 15.0
+
+
+def test_move_linear_rel_behind_goes_backwards(base, executor):  # noqa: F811
+    ready(base)
+    assert base.move_linear_rel((-400.0, 0.0, 0.0)).ok
+    settle(executor, base)
+    assert_at(base, -400.0, 0.0, 0.0)
+    assert base.device.completed == 1
+
+
+@pytest.mark.parametrize("centre_y, angle, end", [
+    (500.0, 90.0, (500.0, 500.0, 90.0)),
+    (-400.0, -90.0, (400.0, -400.0, -90.0)),
+    (300.0, -60.0, (-300.0 * math.sin(math.radians(60)), 300.0 - 300.0 * math.cos(math.radians(60)), -60.0)),
+])
+def test_move_circular_rel_about_a_point_on_the_axle(base, executor, centre_y, angle, end):  # noqa: F811
+    ready(base)
+    assert base.move_circular_rel((0.0, centre_y), angle).ok
+    speeds = []
+    run_until(executor, lambda: speeds.append(base.odometry.v) or not base.device.busy, 20.0)
+    assert_at(base, *end)
+    assert max(abs(v) for v in speeds) <= base.velocity[0] / 1000.0 * 1.05
+
+
+def test_circular_rel_off_the_axle_is_refused(base):
+    ready(base)
+    r = base.move_circular_rel((100.0, 500.0), 90.0)
+    assert not r.ok and "x = 0" in r.comment and base.device.last_id == 0
+
+
+def test_moves_respect_the_velocity_setting(base, executor):  # noqa: F811
+    ready(base)
+    base.set_velocity((200.0, 30.0))
+    base.move_forward(800.0)
+    speeds = []
+    took = run_until(executor, lambda: speeds.append(base.odometry.v) or not base.device.busy, 20.0)
+    assert max(speeds) < 0.21 and took > 4.0
+
+
+def test_full_queue_refuses_and_keeps_what_is_queued(base):
+    ready(base)
+    for _ in range(4):
+        assert base.move_linear_abs((100.0, 0.0, 0.0)).ok
+    r = base.move_linear_abs((200.0, 0.0, 0.0))
+    assert not r.ok and "full" in r.comment
+    assert base.device.queue_length == 4
+
+
+def test_pause_keeps_the_queue_and_accepts_new_motions_resume_runs_them(base, executor):  # noqa: F811
+    ready(base)
+    base.move_forward(600.0)
+    steps(executor, 1.0)
+    assert base.pause().ok and state(base) == VehicleState.PAUSED
+    steps(executor, 1.0)
+    held = position(base)
+    steps(executor, 1.0)
+    assert position(base) == pytest.approx(held, abs=0.5)          # at rest
+    assert abs(base.odometry.v) < 1e-3
+    assert base.move_turn(90.0).ok                                  # Paused accepts "Ready only"
+    assert base.move_linear_abs((600.0, 300.0, 90.0)).ok
+    assert base.device.queue_length == 2 and state(base) == VehicleState.PAUSED
+    assert base.resume().ok
+    settle(executor, base)
+    assert_at(base, 600.0, 300.0, 90.0)
+    assert base.device.completed == 3
+
+
+def test_stop_decelerates_at_the_maximum_and_discards_everything(base, executor):  # noqa: F811
+    ready(base)
+    base.set_velocity((600.0, 45.0))
+    base.move_forward(3000.0)
+    base.move_turn(90.0)
+    run_until(executor, lambda: base.odometry.v > 0.59, 5.0)
+    assert base.stop().ok
+    assert base.device.queue_length == 0
+    took = settle(executor, base)
+    assert took < 0.6 / 1.0 + TRACKING_SETTLE + 0.1
+    assert state(base) == VehicleState.READY
+    x, y, th = position(base)
+    assert x < 3000.0 and abs(th) < 0.5
+    assert base.move_forward(100.0).ok                              # and it moves on
+
+
+def test_servo_off_while_moving_stops_first(base, executor):  # noqa: F811
+    ready(base)
+    base.move_forward(1000.0)
+    steps(executor, 1.0)
+    assert base.set_servo(False).ok and state(base) == VehicleState.POWERED
+    settle(executor, base, 2.0)
+    steps(executor, 0.5)
+    assert abs(base.odometry.v) < 1e-3

@@ -1,0 +1,80 @@
+"""The exceptions of JIS B 8440 Annex 1 §9 and the one error class that reports them.
+
+Every failure of the package (decoding, assembling, executing) is a ``StrolicError`` so that a
+caller can catch one class; ``kind`` says which exception of §9 it is, ``function`` and ``offset``
+say where execution stopped (§4.5: the program stops and the exception is reported).
+"""
+from __future__ import annotations
+
+import enum
+
+
+class ExceptionKind(enum.Enum):
+    """Annex 1 §9 exception kinds, plus the 'other computer errors' this implementation names."""
+
+    # general computer-language exceptions (§9)
+    DIVISION_BY_ZERO = "division by zero"
+    NUMERIC_OVERFLOW = "numeric overflow"
+    NUMERIC_UNDERFLOW = "numeric underflow"
+    STACK_OVERFLOW = "stack overflow"
+    STACK_UNDERFLOW = "stack underflow"
+    TYPE_MISMATCH = "data type mismatch"
+    UNDEFINED_DATA = "undefined data"
+    # 'other computer errors', named so that a report says what went wrong
+    INVALID_CODE = "invalid code"
+    BRANCH_OUT_OF_FUNCTION = "branch target outside the function"
+    NO_RETURN_DESTINATION = "return without a return destination"
+    AREA_ERROR = "access outside the allocated area"
+    SINGULAR_TRANSFORM = "transform has no inverse"
+    DEADLOCK = "every process is waiting"
+    INSTRUCTION_BUDGET = "instruction budget exhausted"
+    COMPUTER_ERROR = "other computer error"
+    # robot-language exceptions (§9)
+    OUT_OF_OPERATING_REGION = "outside the operating region"
+    EXCESSIVE_SPEED = "excessive speed"
+    ROBOT_ERROR = "other robot error"
+    # controller exceptions (§9)
+    EMERGENCY_STOP = "emergency stop"
+    SERVO_ERROR = "servo error"
+    COMMUNICATION_ERROR = "communication error"
+    CONTROLLER_ERROR = "other controller error"
+
+
+class StrolicError(Exception):
+    """An exception state: what happened, in which function, at which byte offset."""
+
+    def __init__(self, kind: ExceptionKind, detail: str = "", *,
+                 function: str | None = None, offset: int | None = None) -> None:
+        super().__init__(detail)
+        self.kind = kind
+        self.detail = detail
+        self.function = function
+        self.offset = offset
+
+    def located(self, function: str | None, offset: int | None) -> "StrolicError":
+        """Fill in the place of the failure unless an inner frame already did."""
+        if self.function is None:
+            self.function = function
+        if self.offset is None:
+            self.offset = offset
+        return self
+
+    def report(self) -> str:
+        """One line for a person: kind, function, offset, detail."""
+        where = []
+        if self.function is not None:
+            where.append(f"in {self.function}")
+        if self.offset is not None:
+            where.append(f"at byte {self.offset} (0x{self.offset:X})")
+        text = f"STROLIC exception: {self.kind.value}"
+        if where:
+            text += " " + " ".join(where)
+        return text + (f": {self.detail}" if self.detail else "")
+
+    def __str__(self) -> str:
+        return self.report()
+
+
+def fail(kind: ExceptionKind, detail: str = "") -> StrolicError:
+    """Build the error to raise; short to write at every check."""
+    return StrolicError(kind, detail)

@@ -1,0 +1,83 @@
+"""Stack items in the text form (see README.md): used by the disassembler, TRACE and ``--stack``.
+
+Formatting is exact: parsing the text gives back the same value, bit for bit.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import opcodes
+from .codes import (ARRAY, LENGTH_TAGS, R4, R8, TAG_NAMES, Array, Function, FunctionCode, Num,
+                    Pose, Record, Str, TagHead, Trn, UserCode, Vec, smallest_int)
+from .values import array_elements
+
+PRINTABLE = set(range(0x20, 0x7F)) - {ord('"'), ord("\\")}
+
+
+def format_real32(value: float) -> str:
+    """The shortest decimal that reads back as the same single-precision value."""
+    return str(np.float32(value))
+
+
+def format_number(num: Num, typed: bool = True) -> str:
+    """Integers bare when their type is the smallest that holds them, reals bare when R8."""
+    if num.tag == R8:
+        text = repr(float(num.value))
+    elif num.tag == R4:
+        text = format_real32(num.value)
+    else:
+        text = str(num.value)
+    bare = num.tag == R8 or (num.tag != R4 and smallest_int(num.value).tag == num.tag)
+    return text if bare or not typed else f"{TAG_NAMES[num.tag]}:{text}"
+
+
+def format_string(data: bytes) -> str:
+    return '"' + "".join(chr(b) if b in PRINTABLE else f"\\x{b:02x}" for b in data) + '"'
+
+
+def format_head(head: TagHead) -> str:
+    name = TAG_NAMES[head.tag]
+    if head.tag == ARRAY:
+        return f"{name}({head.length}, {format_head(head.element)})"
+    if head.tag in LENGTH_TAGS:
+        return f"{name}({head.length})"
+    return name
+
+
+def format_user_code(code: int) -> str:
+    return f"%{code:04X}" if code <= 0xFFFF else f"%{code:08X}"
+
+
+def format_element(value) -> str:
+    """An array element: numbers without type (the array head gives it)."""
+    if isinstance(value, Num):
+        return format_number(value, typed=False)
+    return format_value(value)
+
+
+def format_value(value) -> str:
+    """Any stack item in the text form."""
+    if isinstance(value, Num):
+        return format_number(value)
+    if isinstance(value, Str):
+        return format_string(value.data)
+    if isinstance(value, Record):
+        return f"Rd<{value.data.hex()}>"
+    if isinstance(value, Function):
+        return f"Fn<{value.body.hex()}>"
+    if isinstance(value, Vec):
+        return "Vec(" + " ".join(format_real32(v) for v in value.xyz) + ")"
+    if isinstance(value, Trn):
+        return "Trn(" + " ".join(format_real32(v) for v in value.values) + ")"
+    if isinstance(value, Pose):
+        return "Pm(" + " ".join(format_number(e) for e in value.elements) + ")"
+    if isinstance(value, Array):
+        elements = " ".join(format_element(e) for e in array_elements(value))
+        return f"Ar[{format_head(value.element)}{' ' if elements else ''}{elements}]"
+    if isinstance(value, UserCode):
+        return "#" + format_user_code(value.code)
+    if isinstance(value, FunctionCode):
+        return "#" + opcodes.BY_CODE[value.code].mnemonic
+    if isinstance(value, TagHead):
+        return "#" + format_head(value)
+    raise TypeError(f"not a STROLIC item: {value!r}")

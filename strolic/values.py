@@ -1,0 +1,217 @@
+"""Bytes of data values: head (tag, length, element tag) and data part, both ways.
+
+Used by the program codec, by arrays (elements are data parts under one element head), by the
+heap areas and by EXTB/EMBB, so the byte layout of §6–§15 is written down once, here.
+"""
+from __future__ import annotations
+
+import math
+import struct
+
+from .codes import (ARRAY, FIXED_SIZE, FUNCTION, INDIRECT, INT_FORMAT, INT_RANGE,
+                    INTEGER_TAGS, LENGTH_TAGS, NUMERIC_TAGS, POSE, R4, R8, REAL_FORMAT, RECORD,
+                    STRING, SUPPRESS, TAG_NAMES, TRANSFORM, VECTOR, Array, Function,
+                    FunctionCode, Num, Pose, Record, Str, TagHead, Trn, UserCode, Vec)
+from .errors import ExceptionKind as K, fail
+
+
+def invalid(detail: str, offset: int | None = None) -> Exception:
+    error = fail(K.INVALID_CODE, detail)
+    error.offset = offset
+    return error
+
+
+# ---- lengths and numbers ------------------------------------------------------------------------
+def encode_length(length: int) -> bytes:
+    """§6.2: a length is a tagged integer, the 1-byte form up to 127; the smallest form is used."""
+    for tag in INTEGER_TAGS:
+        if INT_RANGE[tag][0] <= length <= INT_RANGE[tag][1]:
+            return bytes([tag]) + struct.pack(INT_FORMAT[tag], length)
+    raise fail(K.NUMERIC_OVERFLOW, f"length {length} does not fit I4")
+
+
+def encode_number_data(num: Num) -> bytes:
+    fmt = INT_FORMAT.get(num.tag) or REAL_FORMAT[num.tag]
+    return struct.pack(fmt, num.value)
+
+
+def decode_number_data(tag: int, data: bytes, offset: int = 0) -> Num:
+    """Big-endian two's complement integers and IEEE 754 reals (Reference 2: no NaN, no ∞)."""
+    if tag in INT_FORMAT:
+        return Num(tag, struct.unpack(INT_FORMAT[tag], data)[0])
+    value = struct.unpack(REAL_FORMAT[tag], data)[0]
+    if math.isnan(value) or math.isinf(value):
+        raise invalid(f"{TAG_NAMES[tag]} bit pattern is not a number", offset)
+    return Num(tag, value)
+
+
+MAX_NESTING = 64     # array heads in array heads, function data in function data
+
+
+class Reader:
+    """A cursor over code bytes; ``base`` turns positions into offsets of the whole program."""
+
+    def __init__(self, data: bytes, base: int = 0) -> None:
+        self.data = data
+        self.pos = 0
+        self.base = base
+
+    @property
+    def offset(self) -> int:
+        return self.base + self.pos
+
+    def at_end(self) -> bool:
+        return self.pos >= len(self.data)
+
+    def take(self, count: int) -> bytes:
+        if count < 0 or self.pos + count > len(self.data):
+            raise invalid(f"code ends inside a datum (needs {count} bytes)", self.offset)
+        chunk = self.data[self.pos:self.pos + count]
+        self.pos += count
+        return chunk
+
+    def byte(self) -> int:
+        return self.take(1)[0]
+
+    def number(self) -> Num:
+        start = self.offset
+        tag = self.byte()
+        if tag not in NUMERIC_TAGS:
+            raise invalid(f"0x{tag:02X} is not a numeric tag", start)
+        return decode_number_data(tag, self.take(FIXED_SIZE[tag]), start)
+
+    def length(self) -> int:
+        """A length: any integer tag, non-negative, in its smallest form (so bytes round-trip)."""
+        start = self.offset
+        tag = self.byte()
+        if tag not in INTEGER_TAGS:
+            raise invalid("a length must be a tagged integer", start)
+        value = decode_number_data(tag, self.take(FIXED_SIZE[tag])).value
+        if value < 0:
+            raise invalid(f"negative length {value}", start)
+        if encode_length(value)[0] != tag:
+            raise invalid(f"length {value} not in its smallest integer form", start)
+        return value
+
+    def head(self, first: int, depth: int = 0) -> TagHead:
+        """The data-tag-part after its first byte ``first`` (§6.1)."""
+        start = self.offset - 1
+        if depth > MAX_NESTING:
+            raise invalid(f"arrays nested deeper than {MAX_NESTING}", start)
+        tag = first
+        if first == 0xFF:
+            tag = 0xFF00 | self.byte()
+        if tag in FIXED_SIZE or tag in (SUPPRESS, INDIRECT):
+            return TagHead(tag)
+        if tag == ARRAY:
+            length = self.length()
+            element_first = self.byte()
+            element = self.head(element_first, depth + 1)
+            if element.tag in (SUPPRESS, INDIRECT):
+                raise invalid("array elements must be data", start)
+            return TagHead(tag, length, element)
+        if tag in LENGTH_TAGS:
+            return TagHead(tag, self.length())
+        raise invalid(f"reserved or undefined tag 0x{tag:X}", start)
+
+
+# ---- heads --------------------------------------------------------------------------------------
+def encode_head(head: TagHead) -> bytes:
+    tag = head.tag.to_bytes(2 if head.tag > 0xFF else 1, "big")
+    if head.tag == ARRAY:
+        return tag + encode_length(head.length) + encode_head(head.element)
+    if head.tag in LENGTH_TAGS:
+        return tag + encode_length(head.length)
+    return tag
+
+
+def head_of(value: object) -> TagHead:
+    """The head a value is written with."""
+    if isinstance(value, Num):
+        return TagHead(value.tag)
+    if isinstance(value, Array):
+        return TagHead(ARRAY, len(value.data), value.element)
+    if isinstance(value, (Vec, Trn)):
+        return TagHead(VECTOR if isinstance(value, Vec) else TRANSFORM)
+    tag = {Str: STRING, Record: RECORD, Function: FUNCTION, Pose: POSE}.get(type(value))
+    if tag is None:
+        raise fail(K.TYPE_MISMATCH, f"{type(value).__name__} is not data")
+    return TagHead(tag, len(data_of(value)))
+
+
+def data_of(value: object) -> bytes:
+    """The data part: the bytes after the head."""
+    if isinstance(value, Num):
+        return encode_number_data(value)
+    if isinstance(value, (Str, Record, Array)):
+        return value.data
+    if isinstance(value, Function):
+        return value.body
+    if isinstance(value, Vec):
+        return struct.pack(">3f", *value.xyz)
+    if isinstance(value, Trn):
+        return struct.pack(">12f", *value.values)
+    if isinstance(value, Pose):
+        return b"".join(bytes([e.tag]) + encode_number_data(e) for e in value.elements)
+    raise fail(K.TYPE_MISMATCH, f"{type(value).__name__} is not data")
+
+
+def encode_value(value: object) -> bytes:
+    """A tagged data code."""
+    return encode_head(head_of(value)) + data_of(value)
+
+
+def encode_item(item: object) -> bytes:
+    """Any stack item as code: data, or a suppressed user code, function code or tag (#…)."""
+    if isinstance(item, TagHead):
+        return bytes([SUPPRESS]) + encode_head(item)
+    if isinstance(item, (UserCode, FunctionCode)):
+        return bytes([SUPPRESS]) + encode_function_code(item.code)
+    return encode_value(item)
+
+
+def encode_function_code(code: int) -> bytes:
+    """2-byte codes, 4-byte extended user codes."""
+    return code.to_bytes(4 if code > 0xFFFF else 2, "big")
+
+
+def value_from_data(head: TagHead, data: bytes, offset: int = 0) -> object:
+    """The value that ``head`` and its data part ``data`` describe (data of the exact size)."""
+    tag = head.tag
+    if tag in NUMERIC_TAGS:
+        return decode_number_data(tag, data, offset)
+    if tag == STRING:
+        return Str(bytes(data))
+    if tag == RECORD:
+        return Record(bytes(data))
+    if tag == FUNCTION:
+        return Function(bytes(data), offset)
+    if tag in (VECTOR, TRANSFORM):
+        count = 3 if tag == VECTOR else 12
+        values = struct.unpack(f">{count}f", data)
+        if any(math.isnan(v) or math.isinf(v) for v in values):
+            raise invalid("vector or transform element is not a number", offset)
+        return Vec(values) if tag == VECTOR else Trn(values)
+    if tag == ARRAY:
+        size = head.element.element_size()
+        if (size == 0 and data) or (size and len(data) % size):
+            raise invalid(f"array length {len(data)} is not a multiple of element size {size}",
+                          offset)
+        for start in range(0, len(data), size or 1):   # every element must be valid data
+            value_from_data(head.element, data[start:start + size], offset + start)
+        return Array(head.element, bytes(data))
+    if tag == POSE:
+        reader = Reader(bytes(data), offset)
+        elements = []
+        while not reader.at_end():
+            elements.append(reader.number())
+        return Pose(tuple(elements))
+    raise invalid(f"{TAG_NAMES.get(tag, hex(tag))} has no data", offset)
+
+
+def array_elements(array: Array) -> list:
+    """The elements of an array as values (smallest subscript first)."""
+    size = array.element.element_size()
+    return [value_from_data(array.element, array.data[i:i + size])
+            for i in range(0, len(array.data), size)] if size else []
+

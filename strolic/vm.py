@@ -1,0 +1,259 @@
+"""The intermediate-code machine of Reference 1: compiling codes, scheduler, dispatch.
+
+Processes are scheduled cooperatively: the runnable process with the smallest priority number
+runs for a slice; a blocking function (LOCK, EWAIT, CHIN …) returns ``WAIT`` and is retried
+when something changed.
+"""
+from __future__ import annotations
+
+from . import opcodes
+from .codec import CodeKind, decode, decode_function
+from .codes import Function, Num, UserCode, is_user_code, user_code_of, user_key
+from .errors import ExceptionKind as K, StrolicError, fail
+from .host import Host
+from .process import (BUILTIN, CYCLE_WAIT, INDIRECT, PUSH, USER, WAIT, Frame, Process,
+                      State)
+from .variables import Scope, find
+
+SLICE = 200              # instructions a process runs before the scheduler looks again
+DEFAULT_EPS = 1e-6
+
+
+class VM:
+    """Runs a decoded program; the state parameters of Reference 1 §2(6) live here."""
+
+    def __init__(self, host: Host | None = None, *, max_stack: int = 100_000,
+                 max_return_depth: int = 10_000, max_nesting: int = 32,
+                 heap_limit: int = 1 << 24) -> None:
+        self.host = host or Host()
+        self.max_stack = max_stack
+        self.max_return_depth = max_return_depth
+        self.max_nesting = max_nesting
+        self.heap_limit = heap_limit
+        self._compiled: dict[bytes, list] = {}
+        self.generation = 0                # bumped whenever waiting processes may proceed
+        self.executed = 0                  # instructions of the current run (budget)
+        self.budget: int | None = None
+        self.main: Process | None = None   # process 0, the program of the current run
+        self.reset()
+
+    # ---- state ----------------------------------------------------------------------------------
+    def reset(self) -> None:
+        """Everything INIT initialises (EF6E)."""
+        self.globals = Scope(0)
+        self.eps = DEFAULT_EPS
+        self.trace = False
+        self.configuration = 0             # SCONF bits (RIGHTY/LEFTY, ABOVE/BELOW, FLIP/NOFLIP)
+        self.elbow = 0.0                   # arm angle of a 7-axis arm, degree
+        self.flags: set[int] = set()       # event flags that are on
+        self.channels: dict[int, object] = {}
+        self.processes: dict[int, Process] = {}
+
+    def changed(self) -> None:
+        self.generation += 1
+
+    def scopes_for_new_process(self) -> list[Scope]:
+        return [self.globals]
+
+    # ---- compiling codes into instructions ------------------------------------------------------
+    def compile(self, codes: list, origin: int = 0) -> list:
+        """Instructions (op, argument, offset in the body, size) from decoded codes."""
+        instructions = []
+        for code in codes:
+            offset = code.offset - origin
+            if code.kind is CodeKind.CALL:
+                if is_user_code(code.value):
+                    instruction = (USER, user_key(code.value), offset, code.size)
+                else:
+                    instruction = (BUILTIN, opcodes.BY_CODE[code.value], offset, code.size)
+            elif code.kind is CodeKind.INDIRECT:
+                instruction = (INDIRECT, user_key(code.value), offset, code.size)
+            else:
+                instruction = (PUSH, code.value, offset, code.size)
+            instructions.append(instruction)
+        return instructions
+
+    def function_frame(self, function: Function, name: str) -> Frame:
+        """A frame for a function body; bodies are compiled once (offsets relative to the body)."""
+        codes = self._compiled.get(function.body)
+        if codes is None:
+            codes = self._compiled[function.body] = self.compile(decode_function(function),
+                                                                 function.origin or 0)
+        return Frame(codes, function.origin or 0, function, name)
+
+    # ---- running --------------------------------------------------------------------------------
+    def run(self, program: bytes | list, budget: int | None = None) -> Process:
+        """Run a program (bytes or decoded codes) to its end; returns the main process.
+
+        Raises StrolicError for every exception state; ``budget`` bounds the instructions."""
+        codes = decode(program) if isinstance(program, (bytes, bytearray)) else program
+        main = Process(0, Frame(self.compile(codes), 0, None, "program"), [self.globals])
+        self.main = main
+        self.processes = {0: main}
+        self.budget = budget
+        self.executed = 0
+        try:
+            while main.state is not State.DONE:
+                proc = self._pick()
+                if proc is None:
+                    self._idle()
+                    continue
+                self._execute(proc, SLICE)
+        except StrolicError as error:
+            self.host.stop(error)
+            raise
+        return main
+
+    def _eligible(self, proc: Process, now: float | None) -> bool:
+        if proc.state is State.RUNNING:
+            return True
+        if proc.state is State.WAITING:
+            if proc.period and proc.blocked_at == CYCLE_WAIT:
+                return now is not None and now >= proc.next_start
+            return proc.blocked_at != self.generation
+        return False
+
+    def _pick(self) -> Process | None:
+        cyclic = any(p.period for p in self.processes.values())
+        now = self.host.now() if cyclic else None
+        best = None
+        for proc in self.processes.values():
+            if self._eligible(proc, now) and (best is None or (proc.priority, proc.last_run)
+                                              < (best.priority, best.last_run)):
+                best = proc
+        if best is not None and best.state is State.WAITING:
+            if best.blocked_at == CYCLE_WAIT:
+                best.restart()
+            else:
+                best.state = State.RUNNING
+        return best
+
+    def _idle(self) -> None:
+        """Nothing can run: sleep until a cyclic start is due, or report the deadlock."""
+        due = [p.next_start for p in self.processes.values()
+               if p.state is State.WAITING and p.blocked_at == CYCLE_WAIT]
+        if not due:
+            frame = self.main.frame
+            code = frame.codes[frame.pc] if frame.pc < len(frame.codes) else None
+            raise self._locate(fail(K.DEADLOCK, "every process waits and nothing can wake them"),
+                               self.main, frame, code)
+        self.host.sleep(min(due) - self.host.now())
+
+    def finish(self, proc: Process) -> None:
+        """A process's root function returned: wait for its next cycle or end."""
+        self.changed()
+        if proc.period:
+            proc.state = State.WAITING
+            proc.blocked_at = CYCLE_WAIT
+            now = self.host.now()
+            while proc.next_start <= now:
+                proc.next_start += proc.period
+        else:
+            proc.state = State.DONE
+
+    def _execute(self, proc: Process, limit: int) -> None:
+        """The dispatch loop: up to ``limit`` instructions of ``proc`` (fewer if it waits/ends)."""
+        stack = proc.stack
+        frame = proc.frame
+        codes = frame.codes
+        count = 0
+        budget = self.budget
+        instruction = None
+        try:
+            while count < limit and proc.state is State.RUNNING:
+                pc = frame.pc
+                if pc >= len(codes):
+                    self.fall_off(proc)
+                else:
+                    instruction = codes[pc]
+                    frame.pc = pc + 1
+                    op = instruction[0]
+                    if op == PUSH:
+                        stack.append(instruction[1])
+                    elif op == BUILTIN:
+                        handler = instruction[1].handler
+                        result = (handler(self, proc) if handler is not None
+                                  else self.host.call(self, proc, instruction[1]))
+                        if result is WAIT:
+                            frame.pc = pc
+                            proc.state = State.WAITING
+                            proc.blocked_at = self.generation
+                            break
+                    elif op == USER:
+                        self.evaluate_user(proc, instruction[1])
+                    else:
+                        self.evaluate_user(proc, self.indirect_key(proc, instruction[1]))
+                    if len(stack) > self.max_stack:
+                        raise fail(K.STACK_OVERFLOW, f"more than {self.max_stack} items")
+                    count += 1
+                    if budget is not None and self.executed + count > budget:
+                        raise fail(K.INSTRUCTION_BUDGET, f"{budget} instructions executed")
+                if proc.frame is not frame:
+                    frame = proc.frame
+                    codes = frame.codes
+        except StrolicError as error:
+            raise self._locate(error, proc, frame, instruction)
+        except (ArithmeticError, ValueError, TypeError, IndexError, KeyError,
+                RecursionError, MemoryError) as error:
+            raise self._locate(fail(K.COMPUTER_ERROR, f"{type(error).__name__}: {error}"),
+                               proc, frame, instruction) from error
+        finally:
+            self.executed += count
+            proc.last_run = self.executed
+
+    def _locate(self, error: StrolicError, proc: Process, frame: Frame,
+                instruction) -> StrolicError:
+        """Name the failing code and its byte offset in the program (§4.5 report)."""
+        if instruction is None:
+            return error
+        op, argument, offset, _ = instruction
+        name = (argument.mnemonic if op == BUILTIN else f"%{argument:04X}" if op == USER
+                else f"@%{argument:04X}" if op == INDIRECT else "data")
+        if frame.function is not None:
+            name += f" (in function {frame.name})"
+        if proc.number:
+            name += f" (process {proc.number})"
+        return error.located(name, frame.origin + offset)
+
+    # ---- frames and calls -----------------------------------------------------------------------
+    def fall_off(self, proc: Process) -> None:
+        """Past the last code: the program ends, or a function body returns like END."""
+        if proc.frame is proc.root and proc.frame.function is None:
+            proc.state = State.DONE
+            self.changed()
+        else:
+            self.end_function(proc)
+
+    def call(self, proc: Process, function: Function, name: str) -> None:
+        if len(proc.returns) >= self.max_return_depth:
+            raise fail(K.STACK_OVERFLOW, "return stack overflow")
+        proc.returns.append(("call", proc.frame))
+        proc.frame = self.function_frame(function, name)
+
+    def end_function(self, proc: Process) -> None:
+        """END: leave the function, dropping its BAL links; a process's root function ends it."""
+        while proc.returns:
+            kind, target = proc.returns.pop()
+            if kind == "call":
+                proc.frame = target
+                return
+        if proc.frame.function is not None:
+            self.finish(proc)
+
+    def evaluate_user(self, proc: Process, key: int) -> None:
+        """A function code runs its body; a variable code pushes its value (§17.2)."""
+        value = find(proc.scopes, key).value()
+        if isinstance(value, Function):
+            self.call(proc, value, f"%{key:04X}")
+        else:
+            proc.stack.append(value)
+
+    def indirect_key(self, proc: Process, key: int) -> int:
+        """F7 u: u holds a suppressed user code (or its code value) to evaluate (§8)."""
+        target = find(proc.scopes, key).value()
+        if isinstance(target, UserCode):
+            return user_key(target.code)
+        if isinstance(target, Num):
+            return user_key(user_code_of(target))
+        raise fail(K.TYPE_MISMATCH, "an indirect reference needs a user code in the variable")
+

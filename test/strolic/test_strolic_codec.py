@@ -1,0 +1,210 @@
+"""Data codes both ways (§6–§18), the text form, and decoding fuzz."""
+from __future__ import annotations
+
+import struct
+
+import pytest
+from hypothesis import HealthCheck, given, settings, strategies as st
+
+from strolic import opcodes
+from strolic.codec import Code, CodeKind, decode, encode
+from strolic.codes import (I1, I2, I4, R4, R8, Array, Function, FunctionCode, Num, Pose, Record,
+                           Str, TagHead, Trn, UserCode, Vec)
+from strolic.errors import ExceptionKind as K, StrolicError
+from strolic.text import assemble, disassemble
+from strolic.values import encode_length, encode_value
+
+FUZZ = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+# (value, bytes) pairs from the digest's worked examples and the tables
+EXAMPLES = [
+    (Num(I1, 5), "F1 05"), (Num(I2, 300), "F2 01 2C"), (Num(I4, -1), "F4 FF FF FF FF"),
+    (Num(R4, 1.0), "F5 3F 80 00 00"), (Num(R8, 1.0), "F6 3F F0 00 00 00 00 00 00"),
+    (Array(TagHead(I2), bytes.fromhex("000100020003")), "F9 F1 06 F2 00 01 00 02 00 03"),
+    (Str(b"AB"), "FA F1 02 41 42"),
+    (Function(bytes.fromhex("F101F102EF00EF5C")), "FD F1 08 F1 01 F1 02 EF 00 EF 5C"),
+    (Record(b"\x01\x02"), "FB F1 02 01 02"),
+    (Vec((1.0, 2.0, 3.0)), "FF 01 3F800000 40000000 40400000"),
+    (Trn((1.0,) + (0.0,) * 11), "FF 02 3F800000" + " 00000000" * 11),
+    (Pose((Num(I1, 1), Num(R4, 1.0))), "FF 04 F1 07 F1 01 F5 3F 80 00 00"),
+    (Str(b"x" * 200), "FA F2 00 C8" + " 78" * 200),
+    (Array(TagHead(0xFA, 2), b"abcd"), "F9 F1 04 FA F1 02 61 62 63 64"),
+]
+
+
+@pytest.mark.parametrize("value, text", EXAMPLES)
+def test_data_codes_encode_and_decode(value, text: str) -> None:
+    data = bytes.fromhex(text.replace(" ", ""))
+    assert encode_value(value) == data
+    (code,) = decode(data)
+    assert code.kind is CodeKind.DATA and code.value == value and code.size == len(data)
+
+
+@pytest.mark.parametrize("text, item", [
+    ("F0 10 00", UserCode(0x1000)), ("F0 EF 00", FunctionCode(0xEF00)), ("F0 F0", TagHead(0xF0)),
+    ("F0 F7", TagHead(0xF7)), ("F0 F2", TagHead(I2)), ("F0 FA F1 03", TagHead(0xFA, 3)),
+    ("F0 F9 F1 06 F2", TagHead(0xF9, 6, TagHead(I2))), ("F0 FF 01", TagHead(0xFF01)),
+    ("F0 FF 04 F1 10", TagHead(0xFF04, 16)), ("F0 EB 00 12 34", UserCode(0xEB001234)),
+])
+def test_suppressed_items(text: str, item) -> None:
+    (code,) = decode(bytes.fromhex(text.replace(" ", "")))
+    assert code.kind is CodeKind.SUPPRESSED and code.value == item
+
+
+def test_function_codes_user_codes_and_indirect_references() -> None:
+    codes = decode(bytes.fromhex("EF00 1000 EAFF EB001234 F71000 ED11"))
+    assert [(c.kind, c.value, c.offset) for c in codes] == [
+        (CodeKind.CALL, 0xEF00, 0), (CodeKind.CALL, 0x1000, 2), (CodeKind.CALL, 0xEAFF, 4),
+        (CodeKind.CALL, 0xEB001234, 6), (CodeKind.INDIRECT, 0x1000, 10), (CodeKind.CALL, 0xED11, 13)]
+
+
+@pytest.mark.parametrize("text, reason", [
+    ("0FFF", "user codes start at 1000"), ("EF8F", "unassigned function"), ("EC00", "unassigned"),
+    ("F3", "reserved tag"), ("F8", "reserved tag"), ("FC", "reserved tag"), ("FE", "Mc reserved"),
+    ("FF03", "reserved extended tag"), ("FF80", "user extension without format"),
+    ("F2 00", "truncated integer"), ("FA F1 05 41", "string shorter than its length"),
+    ("FA F2 00 05 4141414141", "length not in smallest form"), ("FA F1 FF", "negative length"),
+    ("FA F5 00000000", "length must be an integer"), ("FD F1 02 F1 01", "no END"),
+    ("FD F1 02 EF 00", "function data must end with END"), ("F7 EF 00", "indirect to a function"),
+    ("F7 F1", "indirect without a user code"), ("F5 7F C0 00 00", "NaN"), ("F6 7FF0000000000000", "inf"),
+    ("F9 F1 03 F2 000100", "array length not a multiple"), ("F9 F1 00 F0", "array of #"),
+    ("FF 04 F1 02 FA 00", "pose elements must be numbers"), ("F0 0F FF", "# of an unused code"),
+])
+def test_invalid_codes_are_reported(text: str, reason: str) -> None:
+    with pytest.raises(StrolicError) as caught:
+        decode(bytes.fromhex(text.replace(" ", "")))
+    assert caught.value.kind is K.INVALID_CODE, reason
+    assert caught.value.offset is not None
+
+
+def test_error_offsets_point_into_nested_function_bodies() -> None:
+    program = bytes.fromhex("F101 FD F1 04 F3 00 EF 5C")
+    with pytest.raises(StrolicError) as caught:
+        decode(program)
+    assert caught.value.offset == 5
+
+
+def test_text_form_round_trip_of_a_program_with_everything() -> None:
+    text = """
+    .name x %1000
+    VAR #x DCL #x FDEF Fn{ a: x 1 ADD >a BRT Fn{ END } DROP END }
+    I1:5 I2:5 I4:5 R4:1.5 R8:1.5 -3 300 70000 2.5e-3 "A\\"\\\\\\x00\\n" Rd<0102ff>
+    Ar[I2 1 2 3] Ar[R4 0.5] Ar[St(2) "ab" "cd"] Ar[Vec Vec(1 2 3)] Ar[Ar(4, I2) Ar[I2 1 2] Ar[I2 3 4]]
+    Ar[Rd(1) Rd<01> Rd<02>] Ar[Fn(2) Fn<ef5c>] Vec(1 -2.5 3e10) Trn(1 2 3 4 5 6 7 8 9 10 11 12)
+    Pm(1.0 I2:0 R4:0.5) Fn<f101ef5c>
+    #I1 #I2 #I4 #R4 #R8 #St(3) #Rd(0) #Fn(2) #Vec #Trn #Pm(9) #Ar(6, I2) ## #Rf
+    #ADD #$WAIT #%1000 #%EB001234 @x @%EB001000 %EAFF FPRECD $WAIT AJMOVE
+    """
+    program = assemble(text)
+    assert assemble(disassemble(program)) == program
+    assert disassemble(assemble(disassemble(program))) == disassemble(program)
+
+
+def test_assembler_labels_compute_branch_offsets() -> None:
+    program = assemble("Fn{ top: 1 >top BRA >end BRT end: END }")
+    body = decode(program)[0].value.body
+    assert body == bytes.fromhex("F101 F2FFF9 EF58 F20000 EF5A EF5C")
+
+
+@pytest.mark.parametrize("text", [
+    "FOO", "%0FFF", "%EC00", "I3:5", "I1:300", "Vec(1 2)", "Ar[I2 1.5]", "Ar[St(2) \"abc\"]",
+    "Fn{ 1 ", ">nowhere BRA", "Fn{ a: >a }", ".name ADD %1000", "\"\\q\"", "#Ar(2)", "<01>",
+    "R4:1e39", "Fn{ 1 }",
+])
+def test_assembler_rejects_bad_text(text: str) -> None:
+    with pytest.raises(StrolicError):
+        assemble(text)
+
+
+# ---- hypothesis: generated programs round-trip; random bytes only raise StrolicError -------------
+def numbers():
+    return st.one_of(
+        st.integers(-128, 127).map(lambda v: Num(I1, v)),
+        st.integers(-2**15, 2**15 - 1).map(lambda v: Num(I2, v)),
+        st.integers(-2**31, 2**31 - 1).map(lambda v: Num(I4, v)),
+        st.floats(width=32, allow_nan=False, allow_infinity=False).map(lambda v: Num(R4, v)),
+        st.floats(allow_nan=False, allow_infinity=False).map(lambda v: Num(R8, v)))
+
+
+f32 = st.floats(width=32, allow_nan=False, allow_infinity=False)
+FUNCTION_CODES = [row.code for row in opcodes.TABLE if row.code != 0xEF5C]
+user_codes = st.one_of(st.sampled_from([0x1000, 0x1001, 0x1002]), st.integers(0x1000, 0xEAFF),
+                       st.integers(0xEB000000, 0xEBFFFFFF))
+
+
+def data_values(codes):
+    return st.one_of(
+        numbers(), st.binary(max_size=140).map(Str), st.binary(max_size=8).map(Record),
+        st.tuples(f32, f32, f32).map(Vec), st.tuples(*[f32] * 12).map(Trn),
+        st.lists(numbers(), max_size=4).map(lambda e: Pose(tuple(e))),
+        st.lists(st.integers(-2**15, 2**15 - 1), max_size=5).map(
+            lambda v: Array(TagHead(I2), struct.pack(f">{len(v)}h", *v))),
+        st.lists(f32, max_size=4).map(lambda v: Array(TagHead(R4), struct.pack(f">{len(v)}f", *v))),
+        st.integers(0, 3).flatmap(lambda k: st.lists(st.binary(min_size=k, max_size=k), max_size=3)
+                                  .map(lambda v: Array(TagHead(0xFA, k), b"".join(v)))),
+        st.lists(st.tuples(f32, f32, f32), max_size=2).map(
+            lambda v: Array(TagHead(0xFF01), b"".join(struct.pack(">3f", *x) for x in v))),
+        codes.map(lambda body: Function(encode(body + [Code(CodeKind.CALL, 0xEF5C, 0, 0)]))))
+
+
+def program_codes():
+    def extend(children):
+        return st.lists(st.one_of(
+            data_values(children).map(lambda v: Code(CodeKind.DATA, v, 0, 0)),
+            st.sampled_from(FUNCTION_CODES).map(lambda c: Code(CodeKind.CALL, c, 0, 0)),
+            user_codes.map(lambda c: Code(CodeKind.CALL, c, 0, 0)),
+            user_codes.map(lambda c: Code(CodeKind.INDIRECT, c, 0, 0)),
+            user_codes.map(lambda c: Code(CodeKind.SUPPRESSED, UserCode(c), 0, 0)),
+            st.sampled_from([TagHead(I2), TagHead(0xFA, 3), TagHead(0xF9, 4, TagHead(I2)),
+                             TagHead(0xF0), TagHead(0xFF01), TagHead(0xFF04, 0)]).map(
+                lambda h: Code(CodeKind.SUPPRESSED, h, 0, 0))), max_size=6)
+    return st.recursive(st.just([]), extend, max_leaves=12)
+
+
+@FUZZ
+@given(program_codes())
+def test_generated_programs_round_trip_through_bytes_and_text(codes) -> None:
+    program = encode(codes)
+    decoded = decode(program)
+    assert encode(decoded) == program
+    assert [(c.kind, c.value) for c in decoded] == [(c.kind, c.value) for c in codes]
+    assert assemble(disassemble(program)) == program
+
+
+def check_decoding(data: bytes) -> None:
+    """Decoding raises StrolicError or gives codes that re-encode, through text too, to ``data``."""
+    try:
+        codes = decode(data)
+    except StrolicError:
+        return
+    assert encode(codes) == data
+    assert assemble(disassemble(data)) == data
+
+
+@FUZZ
+@given(st.binary(max_size=64))
+def test_random_bytes_raise_only_strolic_errors(data: bytes) -> None:
+    check_decoding(data)
+
+
+@FUZZ
+@given(st.lists(st.sampled_from([bytes.fromhex(h) for h in (
+    "F1", "F2", "F4", "F5", "F6", "F7", "F9", "FA", "FB", "FD", "FF", "F0", "01", "02", "04",
+    "10", "EF", "5C", "EB", "00", "FF01", "FF02", "FF04", "EF5C", "1000")]), max_size=30))
+def test_tag_shaped_bytes_raise_only_strolic_errors(pieces) -> None:
+    check_decoding(b"".join(pieces))
+
+
+def test_deep_nesting_is_an_invalid_code_not_a_crash() -> None:
+    deep_array_head = bytes.fromhex("F0") + bytes.fromhex("F9F100") * 2000 + bytes.fromhex("F2")
+    body = bytes.fromhex("EF5C")
+    for _ in range(200):
+        body = bytes.fromhex("FD") + encode_length(len(body)) + body + bytes.fromhex("EF5C")
+    for program in (deep_array_head, body):
+        with pytest.raises(StrolicError) as caught:
+            decode(program)
+        assert caught.value.kind is K.INVALID_CODE and "deeper" in caught.value.detail
+    with pytest.raises(StrolicError):
+        assemble("Fn{ " * 2000)
+    with pytest.raises(StrolicError):
+        assemble("#" + "Ar(0, " * 2000)

@@ -1,0 +1,211 @@
+"""The machine itself: exception reports (§4.5), limits, indirect references, the host hook,
+the output stream, and scheduling of processes."""
+from __future__ import annotations
+
+import pytest
+from hypothesis import HealthCheck, given, settings, strategies as st
+
+from conftest import PRELUDE, RecordingHost, error_of, execute, stack_of
+from strolic.codec import encode
+from strolic.codes import Num, I2
+from strolic.errors import ExceptionKind as K, StrolicError
+from strolic.text import assemble
+from strolic.vm import VM
+from test_strolic_codec import program_codes
+
+
+def test_exception_report_names_function_offset_and_kind() -> None:
+    with pytest.raises(StrolicError) as caught:
+        VM().run(assemble("1 2 ADD 0 DIV"))
+    error = caught.value
+    assert (error.kind, error.function, error.offset) == (K.DIVISION_BY_ZERO, "DIV", 8)
+    assert error.report() == ("STROLIC exception: division by zero in DIV at byte 8 (0x8): "
+                              "DIV by 0")
+
+
+def test_exception_inside_a_function_reports_the_absolute_offset() -> None:
+    program = assemble(".name f %1000 VAR #f DCL #f FDEF Fn{ 1 0 IDIV END } f")
+    with pytest.raises(StrolicError) as caught:
+        VM().run(program)
+    assert caught.value.function == "IDIV (in function %1000)"
+    assert program[caught.value.offset:caught.value.offset + 2] == bytes.fromhex("EF06")
+
+
+def test_execution_stops_at_the_exception() -> None:
+    vm = VM(RecordingHost())
+    with pytest.raises(StrolicError):
+        vm.run(assemble("1 RESULT 1 0 DIV 2 RESULT"))
+    assert vm.host.output == [bytes.fromhex("F101")]
+
+
+def test_instruction_budget_bounds_a_runaway_loop() -> None:
+    error = error_of("#f Fn{ top: >top BRA END } STORE f", budget=1000)
+    assert error.kind is K.INSTRUCTION_BUDGET
+
+
+def test_data_stack_and_return_stack_overflow() -> None:
+    assert error_of("1 2 3 4 5 6", max_stack=5).kind is K.STACK_OVERFLOW
+    assert error_of("#f Fn{ f END } STORE f", max_return_depth=50).kind is K.STACK_OVERFLOW
+
+
+def test_recursion_with_a_branch() -> None:
+    factorial = ("#f Fn{ DUP 1 GT >rec BRT RET rec: DUP DEC f MUL END } STORE I4:10 f")
+    assert stack_of(factorial) == ["3628800"]
+
+
+@pytest.mark.parametrize("program, expected", [
+    ("#y 5 STORE #x #y STORE @x", ["5"]),
+    ("#f Fn{ 9 END } STORE #x #f STORE @x", ["9"]),
+    ("#y 5 STORE #x I2:4097 STORE @x", ["5"]),
+    ("#x 5 STORE @x", K.TYPE_MISMATCH), ("@%2000", K.UNDEFINED_DATA),
+])
+def test_indirect_reference(program: str, expected) -> None:
+    if isinstance(expected, K):
+        assert error_of(program).kind is expected
+    else:
+        assert stack_of(program) == expected
+
+
+def test_extended_user_code_alias_is_the_same_variable() -> None:
+    assert stack_of("#%EB001000 7 STORE x %EB001000") == ["7", "7"]
+
+
+def test_trace_goes_to_the_console_only_when_on() -> None:
+    vm, _ = execute('1 TRACE TRON "a" TRACE Vec(1 2 3) TRACE TROFF 2 TRACE')
+    assert vm.host.lines == ['TRACE "a"', "TRACE Vec(1.0 2.0 3.0)"]
+
+
+def test_sync_and_result_write_the_output_stream() -> None:
+    vm, _ = execute("SYNC 300 RESULT Vec(1 2 3) RESULT")
+    assert vm.host.output == [bytes.fromhex("EF73"), bytes.fromhex("F2012C"),
+                              bytes.fromhex("FF013F8000004000000040400000")]
+
+
+def test_robot_functions_go_to_the_host() -> None:
+    error = error_of("1 JSPEED")
+    assert (error.kind, error.function) == (K.UNDEFINED_DATA, "JSPEED")
+
+    class Robot(RecordingHost):
+        def call(self, vm, proc, opcode):
+            proc.pop()
+            proc.push(Num(I2, 0))       # the error flag of JSPEED
+
+    assert stack_of("50 JSPEED", host=Robot()) == ["I2:0"]
+
+
+def test_robot_exceptions_raised_by_the_host_stop_the_program_and_the_robot() -> None:
+    class Robot(RecordingHost):
+        stopped = None
+
+        def call(self, vm, proc, opcode):
+            raise StrolicError(K.EMERGENCY_STOP, "emergency stop button")
+
+        def stop(self, error):
+            self.stopped = error.kind
+
+    robot = Robot()
+    error = error_of("Trn(0 0 0 1 0 0 0 1 0 0 0 1) PNT ALMOVE 1", host=robot)
+    assert (error.kind, error.function, robot.stopped) == (K.EMERGENCY_STOP, "ALMOVE",
+                                                           K.EMERGENCY_STOP)
+
+
+def test_tasks_go_to_the_host() -> None:
+    class Tasks(RecordingHost):
+        def start_task(self, number):
+            return 0 if number == 3 else -1
+
+        def task_state(self, number):
+            return 1
+
+        def control_task(self, number, action):
+            return 0 if action == "suspend" else 1
+
+    assert stack_of("3 TXQT 4 TXQT 3 TDONE 3 TSUSPEND 3 TKILL 3 5 TPRECD", host=Tasks()) == \
+        ["I2:0", "I2:-1", "I2:1", "I2:0", "I2:1", "I2:1"]
+
+
+def test_processes_have_their_own_stacks_and_share_globals() -> None:
+    assert stack_of("#f Fn{ 7 7 #x 5 STORE 1 ESIG END } STORE 9 #f 1 FXQT DROP 1 EWAIT x") == \
+        ["9", "5"]
+
+
+def test_smaller_priority_number_runs_first() -> None:
+    program = ("#f Fn{ 1 RESULT 1 ESIG END } STORE #g Fn{ 2 RESULT 2 ESIG END } STORE "
+               "#g 2 FXQT #f 1 FXQT 2 50 FPREDC 1 10 FPREDC DROP DROP DROP DROP 1 2 2 EWAITA")
+    vm, _ = execute(program)
+    assert vm.host.output == [bytes.fromhex("F101"), bytes.fromhex("F102")]
+
+
+def test_ewait_releases_only_one_waiter() -> None:
+    program = ("#f Fn{ 1 EWAIT 2 ESIG END } STORE #f 1 FXQT #f 2 FXQT DROP DROP 1 ESIG 2 EWAIT "
+               "1 FDONE 2 FDONE")
+    assert stack_of(program) == ["I2:0", "I2:2"]
+
+
+def test_ret_and_gret_in_a_process_end_it() -> None:
+    assert stack_of("#f Fn{ 1 ESIG RET END } STORE #f 1 FXQT DROP 1 EWAIT 1 FDONE") == ["I2:0"]
+    assert stack_of("#g Fn{ 1 ESIG GRET END } STORE #f Fn{ g END } STORE "
+                    "#f 1 FXQT DROP 1 EWAIT 1 FDONE") == ["I2:0"]
+
+
+def test_init_from_a_process_resets_and_returns_to_the_input_stream() -> None:
+    vm, main = execute("#f Fn{ INIT END } STORE 5 #f 1 FXQT DROP 1 EWAIT 6")
+    assert [item.value for item in main.stack] == [6]
+    assert set(vm.processes) == {0}
+
+
+def test_deadlock_is_reported_where_the_program_waits() -> None:
+    error = error_of("1 EWAIT")
+    assert (error.kind, error.function) == (K.DEADLOCK, "EWAIT")
+
+
+def test_a_function_datum_can_be_started_directly() -> None:
+    assert stack_of("Fn{ 1 ESIG END } 4 FXQT DROP 1 EWAIT 4 FDONE") == ["I2:0"]
+
+
+# ---- executing generated programs never fails with anything but a STROLIC exception ----------
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(program_codes(), st.integers(0, 3))
+def test_random_programs_stop_only_with_strolic_exceptions(codes, declared) -> None:
+    prelude = assemble("VAR #%1000 #%1001 #%1002 DCL #%1000 #%1001 STORE")
+    try:
+        VM(max_stack=1000, max_return_depth=100).run(prelude + encode(codes), budget=5000)
+    except StrolicError as error:
+        assert error.kind is not K.COMPUTER_ERROR, error.report()
+
+
+def test_equal_function_bodies_at_different_offsets_branch_correctly() -> None:
+    body = "Fn{ 0 >a BRF 1 a: 2 END }"
+    assert stack_of(f"#f {body} STORE 5 5 5 #g {body} STORE f g") == ["5", "5", "5", "2", "2"]
+    text = "#f Fn{ 1 EXCH IDIV END } STORE 1 2 3 #g Fn{ 1 EXCH IDIV END } STORE 1 f 0 g"
+    program = assemble(PRELUDE + text)
+    second_idiv = program.rindex(bytes.fromhex("EF06"))
+    with pytest.raises(StrolicError) as caught:
+        VM().run(program)
+    assert caught.value.function == "IDIV (in function %1003)"
+    assert caught.value.offset == second_idiv
+
+
+def test_cyclic_process_runs_every_period_on_the_host_clock() -> None:
+    class Clock(RecordingHost):
+        time = 0.0
+
+        def now(self):
+            return self.time
+
+        def sleep(self, seconds):
+            self.time += seconds
+
+    host = Clock()
+    program = ("#x 0 STORE #f Fn{ #x x INC STORE x RESULT x 3 GEQ >s BRT END s: 2 ESIG END } "
+               "STORE #f 1 FXQT DROP 1 100 FCYCLE DROP 2 EWAIT 1 0 FCYCLE x")
+    _, main = execute(program, host=host)
+    assert [item.value for item in main.stack] == [2, 3]     # waiting for its next start
+    assert host.output == [bytes([0xF1, n]) for n in (1, 2, 3)]
+    assert host.time == pytest.approx(0.2)      # started at 0, then at 0.1 and 0.2
+
+
+def test_variables_persist_between_runs_of_one_vm() -> None:
+    vm = VM()
+    vm.run(assemble(".name x %1000 VAR #x DCL #x 41 STORE"))
+    assert [item.value for item in vm.run(assemble("%1000 INC")).stack] == [42]

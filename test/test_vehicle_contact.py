@@ -1,0 +1,61 @@
+"""Contact sensor and blockage without ROS: a bumper contact locks the base until unlock; a
+blocked base stops as Stuck."""
+import pytest
+
+from acti_motion.vehicle import VehicleState
+from acti_motion.vehicle_alarms import AlarmCode
+from sim_fixtures import executor, run_until  # noqa: F401
+from vehicle_fixtures import base, position, ready, settle, state, state_msg, steps  # noqa: F401
+
+BUMPER_FRONT = 321.0          # mm ahead of base_link
+
+
+@pytest.fixture
+def wall(executor):  # noqa: F811
+    """A fixed wall 300 mm ahead of the bumper."""
+    gap = 0.3
+    executor.world.add_box((BUMPER_FRONT / 1000.0 + gap + 0.1, 0.0, 0.25), (0.1, 0.6, 0.25))
+    return BUMPER_FRONT + 1000.0 * gap
+
+
+def test_contact_locks_the_base_until_unlock(base, executor, wall):  # noqa: F811
+    ready(base)
+    base.set_velocity((200.0, 45.0))
+    assert base.set_digital_sensor_lock(True).ok
+    base.move_forward(1000.0)
+    base.move_turn(90.0)
+    run_until(executor, lambda: state(base) == VehicleState.LOCKED, 5.0)
+    assert state_msg(base) == "Locked" and base.device.queue_length == 0
+    settle(executor, base, 2.0)
+    x, _, _ = position(base)
+    assert wall - BUMPER_FRONT - 5.0 < x < wall - BUMPER_FRONT + 30.0     # stopped at the wall
+    steps(executor, 0.5)
+    assert abs(base.odometry.v) < 5e-3 and state(base) == VehicleState.LOCKED
+    alarms = base.get_active_alarm(5).values["active_alarms"]
+    assert (AlarmCode.CONTACT, 1) in [(a[0], a[1]) for a in alarms]       # a FAULT
+    r = base.move_forward(-200.0)
+    assert not r.ok and "Locked" in r.comment and "unlock" in r.comment
+    assert base.clear_alarm().ok and state(base) == VehicleState.LOCKED  # clear_alarm is not unlock
+    assert base.unlock().ok and state(base) == VehicleState.READY
+    assert base.move_forward(-200.0).ok                                   # back away
+    settle(executor, base)
+    assert position(base)[0] == pytest.approx(x - 200.0, abs=5.0)
+    assert base.move_forward(400.0).ok                                    # re-armed: locks again
+    run_until(executor, lambda: state(base) == VehicleState.LOCKED, 5.0)
+
+
+def test_contact_with_the_sensor_off_is_a_blockage(base, executor, wall):  # noqa: F811
+    ready(base)
+    base.set_velocity((200.0, 45.0))
+    base.move_forward(1000.0)
+    base.move_forward(500.0)
+    run_until(executor, lambda: state(base) == VehicleState.STUCK, 8.0)
+    assert state_msg(base) == "Stuck" and base.device.queue_length == 0
+    assert base.alarms.has(AlarmCode.STUCK)
+    assert base.get_input(1).values["input"] == 1                          # the bumper input
+    settle(executor, base, 2.0)
+    steps(executor, 0.3)
+    assert abs(base.odometry.v) < 5e-3
+    assert base.move_forward(-300.0).ok and state(base) == VehicleState.BUSY   # moving on clears it
+    settle(executor, base)
+    assert state(base) == VehicleState.READY and base.get_input(1).values["input"] == 0

@@ -1,0 +1,160 @@
+"""move_cruise_abs without ROS: a smooth path through every point, timed by TOPP-RA, that never
+stops between the points and ends on the last."""
+import math
+
+import pytest
+
+from sim_fixtures import executor  # noqa: F401
+from vehicle_fixtures import assert_at, base, ready, steps  # noqa: F401
+
+POINTS = [(1000.0, 500.0), (2000.0, 0.0), (3000.0, 500.0), (3300.0, 1300.0)]
+
+
+def record(executor, base, add_later=()):  # noqa: F811
+    """Run until the base is done, adding points (time s, point) on the way; the trace
+    (x mm, y mm, forward speed m/s, yaw rate rad/s) at every step."""
+    trace, pending = [], list(add_later)
+    while base.device.busy or pending:
+        if pending and executor.world.time >= pending[0][0]:
+            assert base.move_cruise_abs(pending.pop(0)[1]).values["motion_id"] == 1
+        executor.step()
+        p = base.odometry.pose
+        trace.append((1000.0 * p.x, 1000.0 * p.y, base.odometry.v, base.odometry.w))
+        assert executor.world.time < 60.0
+    return trace
+
+
+def check_passes_every_point_without_stopping(trace, points):
+    passes = [min(range(len(trace)), key=lambda i: math.dist(trace[i][:2], p)) for p in points]
+    for p, i in zip(points, passes):
+        assert math.dist(trace[i][:2], p) < 10.0, p            # passed (odometry within 10 mm)
+    assert passes == sorted(passes)                            # in order
+    near_end = next(i for i in range(passes[0], len(trace)) if math.dist(trace[i][:2], points[-1]) < 100.0)
+    assert min(s[2] for s in trace[passes[0]:near_end]) > 0.05  # never stops between the points
+
+
+def test_cruise_through_queued_points(base, executor):  # noqa: F811
+    ready(base)
+    for p in POINTS:
+        assert base.move_cruise_abs(p).values["motion_id"] == 1   # one motion, extended
+    trace = record(executor, base)
+    check_passes_every_point_without_stopping(trace, POINTS)
+    assert_at(base, *POINTS[-1], theta=base.get_position().values["pos"][2])
+    assert base.device.completed == 1
+
+
+def test_points_added_while_cruising_are_passed_smoothly(base, executor):  # noqa: F811
+    ready(base)
+    base.move_cruise_abs(POINTS[0])
+    trace = record(executor, base, [(1.0 + i, p) for i, p in enumerate(POINTS[1:])])
+    check_passes_every_point_without_stopping(trace, POINTS)
+    x, y, _ = base.get_position().values["pos"]
+    assert math.dist((x, y), POINTS[-1]) < 5.0
+
+
+def test_cruise_respects_the_velocity_and_acceleration_settings(base, executor):  # noqa: F811
+    ready(base)
+    base.set_velocity((400.0, 30.0))
+    base.set_acceleration((300.0, 60.0))
+    for p in POINTS[:3]:
+        base.move_cruise_abs(p)
+    motion = base.device.queue[0].motion
+    path = motion.path
+    dt = 0.005
+    vs = [path.twist(i * dt) for i in range(int(path.duration / dt))]
+    assert max(v for v, _ in vs) <= 0.4 + 1e-6
+    assert max(abs(w) for _, w in vs) <= math.radians(30.0) * 1.01
+    accel = max(abs(b[0] - a[0]) / dt for a, b in zip(vs, vs[1:]))
+    assert accel <= 0.3 * 1.05
+    trace = record(executor, base)
+    assert max(s[2] for s in trace) < 0.4 * 1.05
+
+
+def test_cruise_to_a_point_behind_turns_first_and_queues_after_other_moves(base, executor):  # noqa: F811
+    ready(base)
+    assert base.move_linear_abs((500.0, 0.0, 0.0)).ok
+    assert base.move_cruise_abs((0.0, 300.0)).values["motion_id"] == 2
+    record(executor, base)
+    x, y, _ = base.get_position().values["pos"]
+    assert math.dist((x, y), (0.0, 300.0)) < 5.0
+
+
+@pytest.mark.parametrize("point", [(math.nan, 0.0), (0.0, math.inf)])
+def test_cruise_refuses_bad_points(base, point):
+    ready(base)
+    r = base.move_cruise_abs(point)
+    assert not r.ok and "finite" in r.comment and base.device.last_id == 0
+
+
+def test_cruise_needs_the_servo(base):
+    r = base.move_cruise_abs((100.0, 0.0))
+    assert not r.ok and "Unpowered" in r.comment
+
+
+# --- move_continuous_rel -------------------------------------------------------------------
+def run_recording_speed(executor, base, seconds=None):  # noqa: F811
+    speeds = []
+    limit = executor.world.time + (seconds if seconds is not None else 60.0)
+    while (base.device.busy if seconds is None else True) and executor.world.time < limit:
+        executor.step()
+        speeds.append(base.odometry.v)
+    return speeds
+
+
+def reference_now(base):
+    return base.device.current.motion.at(base.device.t)
+
+
+def expected_mm(pose, rel):
+    from acti_motion.base import Pose2D
+    g = pose.compose(Pose2D(rel[0] / 1000.0, rel[1] / 1000.0, math.radians(rel[2])))
+    return 1000.0 * g.x, 1000.0 * g.y, math.degrees(g.theta)
+
+
+def max_accel(speeds, dt):
+    return max(abs(b - a) for a, b in zip(speeds, speeds[1:])) / dt
+
+
+def test_continuous_rel_from_rest(base, executor):  # noqa: F811
+    ready(base)
+    assert base.move_continuous_rel((300.0, 400.0, 45.0)).ok
+    run_recording_speed(executor, base)
+    assert_at(base, 300.0, 400.0, 45.0)
+
+
+@pytest.mark.parametrize("rel, keeps_moving", [((1500.0, 400.0, 30.0), True),
+                                                ((-500.0, 0.0, 0.0), False)])
+def test_continuous_rel_new_target_replaces_the_old_with_continuous_velocity(
+        base, executor, rel, keeps_moving):  # noqa: F811
+    ready(base)
+    first = base.move_continuous_rel((2000.0, 0.0, 0.0)).values["motion_id"]
+    speeds = run_recording_speed(executor, base, 1.5)
+    here = reference_now(base)
+    assert base.move_continuous_rel(rel).values["motion_id"] == first
+    speeds += run_recording_speed(executor, base)
+    assert_at(base, *expected_mm(here, rel))
+    assert max_accel(speeds, executor.dt) < 0.5 * 1.3           # no jump in speed
+    transition = speeds[int(1.5 / executor.dt):int(2.5 / executor.dt)]
+    assert (min(transition) > 0.2) == keeps_moving
+    assert base.device.completed == 1
+
+
+def test_continuous_rel_keeps_only_the_last_target(base, executor):  # noqa: F811
+    ready(base)
+    base.move_continuous_rel((1000.0, 0.0, 0.0))
+    steps(executor, 0.5)
+    for rel in [(800.0, 200.0, 0.0), (600.0, -100.0, 10.0), (700.0, 0.0, -20.0)]:
+        here = reference_now(base)
+        assert base.move_continuous_rel(rel).ok
+        steps(executor, 0.02)
+    run_recording_speed(executor, base)
+    assert_at(base, *expected_mm(here, rel))
+
+
+def test_continuous_rel_queued_behind_a_move_is_retargeted_from_its_start(base, executor):  # noqa: F811
+    ready(base)
+    base.move_linear_abs((500.0, 0.0, 90.0))
+    a = base.move_continuous_rel((100.0, 0.0, 0.0)).values["motion_id"]
+    assert base.move_continuous_rel((300.0, 0.0, 0.0)).values["motion_id"] == a == 2
+    run_recording_speed(executor, base)
+    assert_at(base, 500.0, 300.0, 90.0)

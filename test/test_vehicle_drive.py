@@ -1,0 +1,83 @@
+"""Velocity drive without ROS: move_jog (timeout, limits, updates) and the joystick."""
+import math
+
+import pytest
+
+from acti_motion.vehicle import VehicleState
+from sim_fixtures import executor, run_until  # noqa: F401
+from vehicle_fixtures import base, ready, settle, state, steps  # noqa: F401
+
+
+def test_jog_runs_while_repeated_and_stops_by_itself_after_the_timeout(base, executor):  # noqa: F811
+    ready(base)
+    assert base.set_jog_timeout(400).ok
+    ids = set()
+    for _ in range(8):                                    # 1.6 s of commands every 0.2 s
+        r = base.move_jog(250.0, 0.0, -15.0)
+        assert r.ok
+        ids.add(r.values["motion_id"])
+        steps(executor, 0.2)
+    assert ids == {1}                                     # one jog, updated in place
+    assert base.odometry.v == pytest.approx(0.25, abs=0.01)
+    assert math.degrees(base.odometry.w) == pytest.approx(-15.0, abs=0.5)
+    steps(executor, 0.15)                                 # 0.35 s after the last call: still on
+    assert base.odometry.v == pytest.approx(0.25, abs=0.01)
+    steps(executor, 0.15 + 0.25 / 0.5 + 0.05)             # past the timeout and the deceleration
+    assert abs(base.odometry.v) < 0.01
+    settle(executor, base, 1.0)
+    assert state(base) == VehicleState.READY
+
+
+def test_jog_accelerates_at_the_setting_and_backwards_is_allowed(base, executor):  # noqa: F811
+    ready(base)
+    base.set_acceleration((200.0, 90.0))
+    base.set_jog_timeout(2000)
+    base.move_jog(-400.0, 0.0, 0.0)
+    steps(executor, 1.0)
+    assert base.odometry.v == pytest.approx(-0.2, abs=0.02)    # 1 s at 200 mm/s²
+
+
+@pytest.mark.parametrize("x_vel, y_vel, theta_vel, words", [
+    (math.nan, 0.0, 0.0, "finite"), (0.0, 0.0, math.inf, "finite"),
+    (1000.5, 0.0, 0.0, "limit"), (-1200.0, 0.0, 0.0, "limit"), (0.0, 0.0, 91.0, "limit"),
+    (100.0, 5.0, 0.0, "sideways"),
+])
+def test_jog_refuses_bad_velocities(base, x_vel, y_vel, theta_vel, words):
+    ready(base)
+    r = base.move_jog(x_vel, y_vel, theta_vel)
+    assert not r.ok and words in r.comment and base.device.last_id == 0
+
+
+def test_jog_needs_the_servo_and_an_idle_base(base):
+    r = base.move_jog(100.0, 0.0, 0.0)
+    assert not r.ok and "Unpowered" in r.comment
+    ready(base)
+    assert base.move_forward(500.0).ok
+    r = base.move_jog(100.0, 0.0, 0.0)
+    assert not r.ok and "queued" in r.comment and base.device.last_id == 1
+
+
+def test_joystick_drives_within_the_settings_and_off_brakes_to_ready(base, executor):  # noqa: F811
+    ready(base)
+    assert not base.joy_input([0.0, 1.0], [])             # off: ignored
+    assert base.set_joystick(True).ok
+    base.set_velocity((200.0, 30.0))
+    for _ in range(20):
+        assert base.joy_input([-0.5, 1.5], [])            # full forward (clamped), half right
+        steps(executor, 0.05)
+    assert base.odometry.v == pytest.approx(0.2, abs=0.01)
+    assert math.degrees(base.odometry.w) == pytest.approx(-15.0, abs=0.5)
+    assert base.set_joystick(False).ok
+    took = run_until(executor, lambda: abs(base.odometry.v) < 0.005, 1.0)
+    assert took < 0.2 / 1.0 + 0.1                          # at the maximum acceleration
+    settle(executor, base, 1.0)
+    assert state(base) == VehicleState.READY
+    assert not base.joy_input([0.0, 1.0], [])
+
+
+def test_joystick_is_ignored_while_moves_are_queued(base):
+    ready(base)
+    base.set_joystick(True)
+    base.move_forward(300.0)
+    assert not base.joy_input([0.0, 1.0], [])
+    assert base.device.last_id == 1 and not base.alarms.active()

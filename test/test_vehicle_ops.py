@@ -1,0 +1,328 @@
+"""VehicleCore without ROS: state table 7, servo table 8, alarms, settings, I/O, battery,
+set_position, and the refusal of bad inputs by every operation."""
+import math
+
+import pytest
+
+from acti_motion.vehicle import FIRMWARE_VERSION, IF_VERSION, VehicleConfig, VehicleCore, VehicleState
+from acti_motion.vehicle_alarms import AlarmCode, AlarmType
+from sim_fixtures import executor, run_until  # noqa: F401
+from vehicle_fixtures import base, ready, settle, state, state_msg, steps  # noqa: F401
+
+NAN, INF = math.nan, math.inf
+
+
+def exhaust_battery(base, executor):  # noqa: F811
+    base.battery.charge = 0.0
+    executor.step()
+
+
+# --- table 8 -------------------------------------------------------------------------------
+@pytest.mark.parametrize("situation, on_off, ok, servo_after", [
+    ("servo on", True, True, True),
+    ("servo on", False, True, False),
+    ("servo off", True, True, True),
+    ("servo off", False, True, False),
+    ("servo off, alarm", True, False, False),
+    ("servo off, alarm", False, True, False),
+    ("power off", True, False, False),
+    ("power off", False, False, False),
+])
+def test_set_servo_follows_table_8(base, executor, situation, on_off, ok, servo_after):  # noqa: F811
+    if situation != "power off":
+        base.set_power(True)
+    if situation == "servo on":
+        base.set_servo(True)
+    if situation == "servo off, alarm":
+        base.set_servo(True)
+        exhaust_battery(base, executor)
+        assert not base.servo and state(base) == VehicleState.ALARM
+    r = base.set_servo(on_off)
+    assert r.ok == ok and base.servo == servo_after
+    if not ok:
+        assert r.comment
+
+
+def test_state_codes_and_strings_walk_table_7(base, executor):  # noqa: F811
+    assert (state(base), state_msg(base)) == (0x019, "Unpowered")
+    base.set_power(True)
+    assert (state(base), state_msg(base)) == (0x018, "Powered")
+    base.set_servo(True)
+    assert (state(base), state_msg(base)) == (0x010, "Ready")
+    assert base.move_forward(200.0).ok
+    assert (state(base), state_msg(base)) == (0x011, "Busy")
+    base.pause()
+    assert (state(base), state_msg(base)) == (0x015, "Paused")
+    base.resume()
+    settle(executor, base)
+    assert not base.set_velocity((-1.0, 10.0)).ok
+    assert (state(base), state_msg(base)) == (0x012, "Warning-101")
+    assert base.clear_alarm().ok
+    assert (state(base), state_msg(base)) == (0x010, "Ready")
+
+
+def test_warning_clears_with_the_next_accepted_command(base):
+    ready(base)
+    assert not base.set_output(0, 1, 1).ok
+    assert state_msg(base) == "Warning-104"
+    assert base.set_velocity((200.0, 30.0)).ok
+    assert state(base) == VehicleState.READY
+
+
+def test_alarm_refuses_motion_until_cleared_and_the_cause_is_gone(base, executor):  # noqa: F811
+    ready(base)
+    exhaust_battery(base, executor)
+    assert (state(base), state_msg(base)) == (0x013, "Alarm-201")
+    r = base.move_linear_abs((100.0, 0.0, 0.0))
+    assert not r.ok and "Alarm" in r.comment and "clear_alarm" in r.comment
+    assert base.clear_alarm().ok                      # always true …
+    assert state(base) == VehicleState.ALARM          # … but the battery is still empty
+    base.battery.charge = 1.0
+    assert base.clear_alarm().ok
+    assert state(base) == VehicleState.POWERED        # the fault turned the servo off
+    assert base.set_servo(True).ok and state(base) == VehicleState.READY
+
+
+def test_power_on_fails_on_an_empty_battery(executor):  # noqa: F811
+    base = VehicleCore(executor, VehicleConfig(battery_charge=0.0))
+    r = base.set_power(True)
+    assert not r.ok and "cut-off" in r.comment and state(base) == VehicleState.UNPOWERED
+
+
+# --- alarms --------------------------------------------------------------------------------
+def test_get_active_alarm_fills_at_most_what_is_asked_and_counts_all(base):
+    ready(base)
+    base.set_velocity((NAN, 1.0))                     # 101
+    base.get_input(99)                                # 104
+    base.move_circular_rel((10.0, 0.0), 90.0)         # 105
+    r = base.get_active_alarm(2)
+    assert r.ok and r.values["num_of_active_alarm"] == 3
+    alarms = r.values["active_alarms"]
+    assert [a[0] for a in alarms] == [101, 104]
+    assert all(a[1] == AlarmType.WARNING for a in alarms)
+    assert "set_velocity" in alarms[0][2] and "finite" in alarms[0][2]
+    for n in (0, -1):
+        r = base.get_active_alarm(n)
+        assert r.values["active_alarms"] == [] and r.values["num_of_active_alarm"] == 3
+    assert len(base.get_active_alarm(10).values["active_alarms"]) == 3
+    base.clear_alarm()
+    assert base.get_active_alarm(10).values["num_of_active_alarm"] == 0
+
+
+def test_faults_come_first_with_the_idl_alarm_type(base, executor):  # noqa: F811
+    ready(base)
+    base.get_servo_status(7)
+    exhaust_battery(base, executor)
+    codes = [(a[0], a[1]) for a in base.get_active_alarm(10).values["active_alarms"]]
+    assert codes[0] == (AlarmCode.BATTERY_EMPTY, 1)           # fault = 1 in the IDL's order
+    assert (AlarmCode.UNKNOWN_ID, 2) in codes                 # warning = 2
+
+
+# --- versions, limits, defaults ------------------------------------------------------------
+def test_versions(base):
+    assert base.get_if_version().values == {"version": "RTC VehicleService interface: ver.2.0.0"}
+    assert IF_VERSION == "RTC VehicleService interface: ver.2.0.0"
+    ver = base.get_version().values["ver"]
+    assert ver == FIRMWARE_VERSION and ver.startswith("Ver.")
+
+
+def test_limits_and_defaults_are_readable(base):
+    c = VehicleConfig()
+    assert base.get_velocity_limit().values == {"vel_limit_t": c.velocity_limit_translation,
+                                                "vel_limit_r": c.velocity_limit_rotation}
+    assert base.get_acceleration_limit().values == {"acc_limit_t": c.accel_limit_translation,
+                                                    "acc_limit_r": c.accel_limit_rotation}
+    assert base.get_default_velocity().values["default_vel"] == (
+        c.default_velocity_translation, c.default_velocity_rotation)
+    assert base.get_default_acceleration().values["default_accel"] == (
+        c.default_accel_translation, c.default_accel_rotation)
+    assert base.velocity == base.get_default_velocity().values["default_vel"]
+
+
+# --- settings ------------------------------------------------------------------------------
+BAD_PAIRS = [(NAN, 10.0), (10.0, INF), (0.0, 10.0), (10.0, 0.0), (-5.0, 10.0), (10.0, -1.0),
+             (1000.1, 10.0), (10.0, 90.5)]
+
+
+@pytest.mark.parametrize("pair", BAD_PAIRS)
+def test_set_velocity_refuses_bad_values(base, pair):
+    r = base.set_velocity(pair)
+    assert not r.ok and r.comment and base.velocity == (300.0, 45.0)
+
+
+@pytest.mark.parametrize("pair", [(NAN, 10.0), (10.0, INF), (0.0, 10.0), (-5.0, 10.0),
+                                  (1000.1, 10.0), (10.0, 180.5)])
+def test_set_acceleration_refuses_bad_values(base, pair):
+    r = base.set_acceleration(pair)
+    assert not r.ok and r.comment and base.acceleration == (500.0, 90.0)
+
+
+def test_settings_at_the_limits_are_taken(base):
+    assert base.set_velocity((1000.0, 90.0)).ok and base.velocity == (1000.0, 90.0)
+    assert base.set_acceleration((1000.0, 180.0)).ok and base.acceleration == (1000.0, 180.0)
+
+
+def test_set_acceleration_is_refused_while_moving_and_velocity_is_not(base, executor):  # noqa: F811
+    ready(base)
+    base.move_forward(300.0)
+    r = base.set_acceleration((800.0, 100.0))
+    assert not r.ok and "moving" in r.comment and base.acceleration == (500.0, 90.0)
+    assert base.set_velocity((200.0, 30.0)).ok
+    settle(executor, base)
+    assert base.set_acceleration((800.0, 100.0)).ok
+
+
+@pytest.mark.parametrize("timeout", [0, -1, -32768])
+def test_set_jog_timeout_refuses_zero_and_negative(base, timeout):
+    r = base.set_jog_timeout(timeout)
+    assert not r.ok and "> 0" in r.comment and base.jog_timeout == 500
+
+
+def test_set_jog_timeout(base):
+    assert base.set_jog_timeout(250).ok and base.jog_timeout == 250
+
+
+# --- servo status, I/O, battery ------------------------------------------------------------
+def test_get_servo_status_per_wheel(base):
+    assert base.get_servo_status(0).values["status"] is False
+    ready(base)
+    assert base.get_servo_status(0).values["status"] and base.get_servo_status(1).values["status"]
+    r = base.get_servo_status(2)
+    assert not r.ok and "axis 2" in r.comment
+
+
+def test_io_module_from_its_config(base):
+    assert base.get_input(4).values["input"] == 5                  # a constant input
+    assert base.get_input(1).values["input"] == 0                  # the bumper, free
+    assert base.set_output(1, 0xFF, 0x0F).ok
+    assert base.get_input(2).values["input"] == 0x0F               # loop-back of output 1
+    assert base.set_output(1, 0x00, 0x03).ok
+    assert base.get_input(2).values["input"] == 0x0C               # only the masked bits changed
+    assert base.get_input(3).values["input"] == 0                  # output 2 untouched
+
+
+@pytest.mark.parametrize("ioid, words", [(0, "reserved"), (3, "not declared"), (99, "not declared")])
+def test_set_output_refuses_reserved_and_unknown_ids(base, ioid, words):
+    r = base.set_output(ioid, 1, 1)
+    assert not r.ok and words in r.comment
+    assert base.io.values == {0: 0, 1: 0, 2: 0}
+
+
+def test_get_input_refuses_unknown_ids(base):
+    r = base.get_input(42)
+    assert not r.ok and "42" in r.comment and state_msg(base) == "Unpowered"
+
+
+def test_battery_voltage_in_tenths_of_a_volt_drains_faster_when_moving(base, executor):  # noqa: F811
+    v = base.get_battery_voltage().values["voltage"]
+    assert 540.0 < v <= 546.0                                     # 54.6 V full: "×10 V"
+    ready(base)
+    c0 = base.battery.charge
+    steps(executor, 3.0)
+    idle = c0 - base.battery.charge
+    c1 = base.battery.charge
+    base.set_velocity((800.0, 90.0))
+    base.move_forward(2000.0)
+    steps(executor, 3.0)
+    moving = c1 - base.battery.charge
+    assert moving > 1.5 * idle > 0.0
+    assert base.get_battery_voltage().values["voltage"] < v
+
+
+def test_battery_low_warning(base, executor):  # noqa: F811
+    ready(base)
+    base.battery.charge = 0.25                        # ~45 V: below 46 V, above 44 V
+    executor.step()
+    assert state_msg(base) == "Warning-110"
+    assert base.move_forward(100.0).ok                # a warning does not refuse motion
+
+
+# --- set_position --------------------------------------------------------------------------
+def test_set_position_redefines_the_origin(base, executor):  # noqa: F811
+    ready(base)
+    assert base.set_position((1000.0, -500.0, 90.0)).ok
+    assert base.get_position().values["pos"] == pytest.approx((1000.0, -500.0, 90.0))
+    base.move_forward(300.0)
+    settle(executor, base)
+    x, y, th = base.get_position().values["pos"]
+    assert abs(x - 1000.0) < 5 and abs(y + 200.0) < 5 and abs(th - 90.0) < 0.5
+
+
+def test_set_position_while_moving_keeps_the_path_on_the_floor(base, executor):  # noqa: F811
+    ready(base)
+    truth0 = executor.world.base_pose()
+    base.move_forward(600.0)
+    steps(executor, 1.0)
+    x, y, th = base.get_position().values["pos"]
+    assert base.set_position((x + 5000.0, y, th)).ok
+    settle(executor, base)
+    x, y, th = base.get_position().values["pos"]
+    assert abs(x - 5600.0) < 5 and abs(y) < 5
+    assert abs(executor.world.base_pose()[0] - truth0[0] - 0.6) < 0.01
+
+
+# --- bad inputs everywhere -----------------------------------------------------------------
+BAD_CALLS = [
+    ("move_forward", dict(x=NAN)), ("move_forward", dict(x=INF)),
+    ("move_turn", dict(theta=NAN)), ("move_turn", dict(theta=-INF)),
+    ("move_linear_rel", dict(pos=(NAN, 0.0, 0.0))), ("move_linear_rel", dict(pos=(0.0, 0.0, INF))),
+    ("move_linear_abs", dict(pos=(0.0, INF, 0.0))), ("move_linear_abs", dict(pos=(NAN, 0.0, 0.0))),
+    ("move_circular_rel", dict(center_point=(0.0, NAN), theta=90.0)),
+    ("move_circular_rel", dict(center_point=(0.0, 100.0), theta=INF)),
+    ("move_circular_rel", dict(center_point=(50.0, 100.0), theta=90.0)),
+    ("move_continuous_rel", dict(pos=(0.0, NAN, 0.0))), ("move_cruise_abs", dict(cruise_point=(INF, 0.0))),
+    ("move_jog", dict(x_vel=NAN, y_vel=0.0, theta_vel=0.0)),
+    ("move_jog", dict(x_vel=0.0, y_vel=0.0, theta_vel=-91.0)),
+    ("set_velocity", dict(vel=(NAN, 1.0))), ("set_acceleration", dict(accel=(1.0, -1.0))),
+    ("set_jog_timeout", dict(timeout=0)), ("set_position", dict(pos=(NAN, 0.0, 0.0))),
+    ("set_output", dict(ioid=0, output=1, mask=1)), ("set_output", dict(ioid=77, output=1, mask=1)),
+    ("get_input", dict(ioid=77)), ("get_servo_status", dict(axisid=5)),
+]
+
+
+@pytest.mark.parametrize("name, kwargs", BAD_CALLS, ids=[f"{n}-{i}" for i, (n, _) in enumerate(BAD_CALLS)])
+def test_bad_inputs_are_refused_with_a_reason_and_the_queue_intact(base, name, kwargs):
+    ready(base)
+    assert base.move_linear_abs((500.0, 0.0, 0.0)).ok
+    queued = (base.device.queue_length, base.device.last_id)
+    r = getattr(base, name)(**kwargs)
+    assert not r.ok and len(r.comment) > 10
+    assert (base.device.queue_length, base.device.last_id) == queued
+    assert base.alarms.active()[-1].source.startswith(name)
+
+
+@pytest.mark.parametrize("name, kwargs", [
+    ("move_forward", dict(x=100.0)), ("move_turn", dict(theta=10.0)),
+    ("move_linear_rel", dict(pos=(100.0, 0.0, 0.0))),
+    ("move_circular_rel", dict(center_point=(0.0, 100.0), theta=10.0)),
+    ("move_linear_abs", dict(pos=(100.0, 0.0, 0.0))),
+])
+@pytest.mark.parametrize("situation", ["unpowered", "powered", "locked"])
+def test_motion_is_refused_without_servo_or_while_locked(base, name, kwargs, situation):
+    if situation != "unpowered":
+        base.set_power(True)
+    if situation == "locked":
+        base.set_servo(True)
+        base.locked = True
+    r = getattr(base, name)(**kwargs)
+    assert not r.ok and situation.capitalize() in r.comment
+    assert base.device.last_id == 0
+
+
+@pytest.mark.parametrize("name, kwargs", [
+    ("move_forward", dict(x=100.0)), ("move_turn", dict(theta=10.0)),
+    ("move_linear_rel", dict(pos=(100.0, 0.0, 0.0))),
+    ("move_circular_rel", dict(center_point=(0.0, 100.0), theta=10.0)),
+])
+def test_ready_only_moves_are_refused_while_busy(base, name, kwargs):
+    ready(base)
+    assert base.move_forward(300.0).ok
+    r = getattr(base, name)(**kwargs)
+    assert not r.ok and "Busy" in r.comment and base.device.last_id == 1
+
+
+def test_always_true_operations(base):
+    for op in (base.clear_alarm, base.pause, base.resume, base.stop, base.unlock):
+        assert op().ok
+    assert base.set_digital_sensor_lock(True).ok and base.set_digital_sensor_lock(False).ok
+    assert base.get_position().ok and base.get_battery_voltage().ok

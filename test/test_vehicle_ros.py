@@ -1,0 +1,147 @@
+"""vehicle_node as a real process over DDS: the operation table, nested messages both ways,
+refusals that leave the node up."""
+import math
+import time
+
+from acti_msgs import srv
+from acti_msgs.msg import VehicleAlarm, VehiclePoint, VehiclePosition, VehicleStatus, VehicleVelocity
+from diagnostic_msgs.msg import DiagnosticArray
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+
+from ros_harness import node_fixture, wait_until
+from vehicle_node.operations import OPERATIONS
+
+vehicle = node_fixture("vehicle_node")
+BASE = "/vehicle_node/"
+
+SERVICES = {
+    "clear_alarm": srv.VehicleClearAlarm, "get_acceleration_limit": srv.VehicleGetAccelerationLimit,
+    "get_active_alarm": srv.VehicleGetActiveAlarm, "get_battery_voltage": srv.VehicleGetBatteryVoltage,
+    "get_default_acceleration": srv.VehicleGetDefaultAcceleration,
+    "get_default_velocity": srv.VehicleGetDefaultVelocity, "get_if_version": srv.VehicleGetIFVersion,
+    "get_input": srv.VehicleGetInput, "get_position": srv.VehicleGetPosition,
+    "get_servo_status": srv.VehicleGetServoStatus, "get_state": srv.VehicleGetState,
+    "get_velocity_limit": srv.VehicleGetVelocityLimit, "get_version": srv.VehicleGetVersion,
+    "move_circular_rel": srv.VehicleMoveCircularRel, "move_continuous_rel": srv.VehicleMoveContinuousRel,
+    "move_cruise_abs": srv.VehicleMoveCruiseAbs, "move_forward": srv.VehicleMoveForward,
+    "move_jog": srv.VehicleMoveJog, "move_linear_abs": srv.VehicleMoveLinearAbs,
+    "move_linear_rel": srv.VehicleMoveLinearRel, "move_turn": srv.VehicleMoveTurn,
+    "pause": srv.VehiclePause, "resume": srv.VehicleResume, "set_acceleration": srv.VehicleSetAcceleration,
+    "set_digital_sensor_lock": srv.VehicleSetDigitalSensorLock, "set_jog_timeout": srv.VehicleSetJogTimeout,
+    "set_joystick": srv.VehicleSetJoystick, "set_output": srv.VehicleSetOutput,
+    "set_position": srv.VehicleSetPosition, "set_power": srv.VehicleSetPower, "set_servo": srv.VehicleSetServo,
+    "set_velocity": srv.VehicleSetVelocity, "stop": srv.VehicleStop, "unlock": srv.VehicleUnlock,
+}
+
+
+def call(ros, name, **fields):
+    return ros.call(SERVICES[name], BASE + name, **fields)
+
+
+def state(ros):
+    return call(ros, "get_state").state
+
+
+def test_every_idl_operation_is_a_service(ros, vehicle):
+    assert len(SERVICES) == 34                                     # the IDL appendix
+    assert sorted(op.name for op in OPERATIONS) == sorted(SERVICES)
+    served = {}
+    wait_until(lambda: served.update(ros.node.get_service_names_and_types())
+               or all(BASE + op.name in served for op in OPERATIONS), 10.0)
+    for op in OPERATIONS:
+        assert served.get(BASE + op.name) == [f"acti_msgs/srv/{SERVICES[op.name].__name__}"], op.name
+
+
+def test_versions_limits_and_nested_replies(ros, vehicle):
+    assert call(ros, "get_if_version").version == "RTC VehicleService interface: ver.2.0.0"
+    assert call(ros, "get_version").ver.startswith("Ver.")
+    r = call(ros, "get_velocity_limit")
+    assert r.success and (r.vel_limit_t, r.vel_limit_r) == (1000.0, 90.0)
+    d = call(ros, "get_default_velocity").default_vel
+    assert (d.translation, d.rotation) == (300.0, 45.0)
+    assert call(ros, "get_battery_voltage").voltage > 500.0
+
+
+def test_settings_and_alarms_over_dds(ros, vehicle):
+    r = call(ros, "set_velocity", vel=VehicleVelocity(translation=math.nan, rotation=10.0))
+    assert not r.success and "finite" in r.message
+    r = call(ros, "get_active_alarm", num_of_alarm=5)
+    assert r.success and r.num_of_active_alarm >= 1
+    a = r.active_alarms[-1]
+    assert (a.code, a.type) == (101, VehicleAlarm.WARNING) and "set_velocity" in a.source
+    assert call(ros, "clear_alarm").success
+    assert call(ros, "set_velocity", vel=VehicleVelocity(translation=500.0, rotation=60.0)).success
+    assert call(ros, "set_output", ioid=1, output=0b1010, mask=0b1111).success
+    assert call(ros, "get_input", ioid=2).input == 0b1010
+    r = call(ros, "set_output", ioid=0, output=1, mask=1)
+    assert not r.success and "reserved" in r.message
+    assert vehicle.alive()
+
+
+def test_moves_over_dds(ros, vehicle):
+    r = call(ros, "move_forward", x=500.0)
+    assert not r.success and "Unpowered" in r.message
+    assert call(ros, "set_power", on_off=True).success
+    assert call(ros, "set_servo", on_off=True).success
+    r = call(ros, "get_state")
+    assert (r.state, r.msg) == (0x010, "Ready")
+    assert call(ros, "set_position", pos=VehiclePosition(x=0.0, y=0.0, theta=0.0)).success
+    r = call(ros, "move_circular_rel", center_point=VehiclePoint(x=0.0, y=400.0), theta=90.0)
+    assert r.success and r.motion_id >= 1
+    r = call(ros, "move_linear_abs", pos=VehiclePosition(x=0.0, y=800.0, theta=180.0))
+    assert r.success
+    assert wait_until(lambda: state(ros) == 0x010, 30.0)
+    pos = call(ros, "get_position").pos
+    assert math.hypot(pos.x, pos.y - 800.0) < 5.0 and abs(abs(pos.theta) - 180.0) < 0.5
+    r = call(ros, "move_circular_rel", center_point=VehiclePoint(x=10.0, y=400.0), theta=90.0)
+    assert not r.success and "x = 0" in r.message
+    assert vehicle.alive()
+
+
+def spin_until(ros, predicate, timeout):
+    """Spin the client (subscriptions) until predicate() holds."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if predicate():
+            return True
+        ros.executor.spin_once(timeout_sec=0.05)
+    return predicate()
+
+
+def test_topics_state_diagnostics_odom_and_cmd_vel(ros, vehicle):
+    got = {"state": [], "diag": [], "odom": [], "truth": []}
+    subs = [ros.node.create_subscription(VehicleStatus, BASE + "state", got["state"].append, 10),
+            ros.node.create_subscription(DiagnosticArray, "/diagnostics", got["diag"].append, 10),
+            ros.node.create_subscription(Odometry, "/odom", got["odom"].append, 10),
+            ros.node.create_subscription(Odometry, BASE + "ground_truth", got["truth"].append, 10)]
+    cmd = ros.node.create_publisher(Twist, "/cmd_vel", 10)
+    try:
+        assert call(ros, "set_power", on_off=True).success and call(ros, "set_servo", on_off=True).success
+        assert spin_until(ros, lambda: all(got.values()), 10.0)
+        status = got["state"][-1]
+        assert (status.state, status.msg, status.power, status.servo) == (0x010, "Ready", True, True)
+        names = [s.name for s in got["diag"][-1].status]
+        assert names == ["vehicle_node: battery", "vehicle_node: alarms"]
+        assert got["diag"][-1].status[0].message.endswith(" V")
+        p0 = got["odom"][-1].pose.pose.position
+        twist = Twist()
+        twist.linear.x = 0.2
+        deadline = time.monotonic() + 1.0                      # 1 s wall = 4 s simulated
+        while time.monotonic() < deadline:
+            cmd.publish(twist)
+            ros.executor.spin_once(timeout_sec=0.05)
+        assert spin_until(ros, lambda: got["state"][-1].state == 0x011, 2.0)   # Busy
+        assert spin_until(ros, lambda: got["state"][-1].state == 0x010, 5.0)   # stopped by itself
+        odom = got["odom"][-1]
+        assert odom.header.frame_id == "odom" and odom.child_frame_id == "base_link"
+        p1 = odom.pose.pose.position
+        moved = math.hypot(p1.x - p0.x, p1.y - p0.y)
+        assert 0.3 < moved < 1.2                                 # metres (REP 103)
+        truth = got["truth"][-1].pose.pose.position
+        assert math.hypot(truth.x - p1.x, truth.y - p1.y) < 0.05
+    finally:
+        for s in subs:
+            ros.node.destroy_subscription(s)
+        ros.node.destroy_publisher(cmd)
+    assert vehicle.alive()
