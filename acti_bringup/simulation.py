@@ -78,3 +78,10 @@ class Simulation:
                 n.destroy_node()
             self.world.close()
             rclpy.try_shutdown()
+
+
+def run_alone(node_class: type, args: list[str] | None = None) -> None:
+    """`python -m <node>`: one node with a simulation of its own, until SIGINT/SIGTERM."""
+    rclpy.init(args=sys.argv if args is None else args)
+    node = node_class()
+    node.simulation.spin(node)
