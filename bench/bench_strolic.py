@@ -1,4 +1,5 @@
-"""Instructions per second of the STROLIC VM on two loops (figures only, no assertions).
+"""Instructions per second of the STROLIC VM on loops (figures only, no assertions): the last
+one with an interrupt enabled, so its detection procedure runs between every two slices.
 
     python bench/bench_strolic.py [iterations]
 """
@@ -42,6 +43,10 @@ top:
 loop
 """
 
+# the arithmetic loop with an interrupt enabled whose detection procedure (an input) stays false
+POLLED_LOOP = ("5 1 Fn{ 1 DIN 1 AND END } ACTCODE 5 Fn{ END } ACTION 1 ACT\n"
+               + ARITHMETIC_LOOP)
+
 
 def measure(name: str, source: str, iterations: int) -> None:
     program = assemble(source.replace("{n}", str(iterations)))
@@ -57,6 +62,7 @@ def main() -> None:
     iterations = int(sys.argv[1]) if len(sys.argv) > 1 else 20_000
     measure("arithmetic/branch loop", ARITHMETIC_LOOP, iterations)
     measure("function-call loop", CALL_LOOP, iterations)
+    measure("arithmetic, interrupt polled", POLLED_LOOP, iterations)
 
 
 if __name__ == "__main__":

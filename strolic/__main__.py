@@ -22,8 +22,10 @@ def load_program(path: Path) -> bytes:
 
 
 def run(args: argparse.Namespace) -> None:
-    """Run; the output stream goes to stderr, the final stack (--stack) to stdout."""
+    """Run; the output stream goes to stderr, the final stack (--stack) to stdout; the files of
+    the program (FOPEN …) are those of its directory."""
     vm = VM()
+    vm.host.file_root = Path(args.program).resolve().parent
     try:
         main = vm.run(decode(load_program(Path(args.program))), budget=args.budget)
     finally:

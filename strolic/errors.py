@@ -28,6 +28,10 @@ class ExceptionKind(enum.Enum):
     SINGULAR_TRANSFORM = "transform has no inverse"
     DEADLOCK = "every process is waiting"
     INSTRUCTION_BUDGET = "instruction budget exhausted"
+    FILE_ERROR = "file input/output error"
+    FILE_OUTSIDE = "file outside the program directory"
+    CONVERSION_ERROR = "conversion error"
+    DETECTION_WAITED = "an interrupt detection procedure waited"
     COMPUTER_ERROR = "other computer error"
     # robot-language exceptions (§9)
     OUT_OF_OPERATING_REGION = "outside the operating region"

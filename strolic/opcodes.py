@@ -11,7 +11,9 @@ from dataclasses import dataclass
 from typing import Callable
 
 from .functions import arithmetic as ar, bits, concurrency as cc, control as ct, data as dt
-from .functions import geometry as ge, strings as st, system as sy
+from .functions import geometry as ge, strings as st, system as sy, system_time as tm
+from .functions import system_files as fl, system_format as fm, system_interrupts as it
+from .functions import system_io as io
 from .codes import I1, I2, I4, R4, R8
 
 
@@ -175,44 +177,44 @@ VM_FUNCTIONS = [
     op(0xEF8E, "SHARE", "#u number --", cc.share),
 ]
 
-# System (EE) and robot-control (ED) functions (effects from part 3 of the digest). They have no
-# handler yet: the VM hands them to Host.call until the robot binding gives them one.
+# System (EE) functions act through the host's hooks; robot-control (ED) functions have no handler
+# yet: the VM hands them to Host.call until the robot binding gives them one (effects: part 3).
 HOST_FUNCTIONS = [
-    op(0xEE00, "TIME", "-- a:St"),
-    op(0xEE01, "DATE", "-- a:St"),
-    op(0xEE02, "CLOCK", "-- a:I4"),
-    op(0xEE03, "STIME", "a:St --"),
-    op(0xEE04, "SDATE", "a:St --"),
-    op(0xEE05, "CLRCLK", "--"),
-    op(0xEE06, "PACKTM", "h m s -- d:St"),
-    op(0xEE07, "UNPKTM", "a:St -- h m s"),
-    op(0xEE08, "PACKDT", "y mo d -- s:St"),
-    op(0xEE09, "UNPKDT", "a:St -- y mo d"),
-    op(0xEE0A, "CNFG", "port flow speed fmt --"),
-    op(0xEE0B, "DOUT", "port data --"),
-    op(0xEE0C, "DIN", "port -- data"),
-    op(0xEE0D, "IOWAIT", "port mask cond timeout -- masked tflag"),
-    op(0xEE0E, "ACT", "level --"),
-    op(0xEE0F, "ACTRS", "level --"),
-    op(0xEE10, "REACT", "--"),
-    op(0xEE11, "ACTCODE", "code level detproc --"),
-    op(0xEE12, "ACTION", "code handler --"),
-    op(0xEE13, "TIMER", "timeout --"),
-    op(0xEE14, "RTIMER", "--"),
-    op(0xEE15, "TACTION", "handler --"),
-    op(0xEE16, "FSTAT", "file -- status:I2"),
-    op(0xEE17, "OUTPUT", "file data --"),
-    op(0xEE18, "INPUT", "file -- data"),
-    op(0xEE19, "LOUTPUT", "file data --"),
-    op(0xEE1A, "LINPUT", "file #t -- data:t"),
-    op(0xEE1B, "FOPEN", "file mode --"),
-    op(0xEE1C, "FCLOSE", "file --"),
-    op(0xEE1D, "PUTC", "file ch --"),
-    op(0xEE1E, "GETC", "file -- ch:I2"),
-    op(0xEE1F, "DECODE1", "str #t -- value"),
-    op(0xEE20, "ENCODE1", "fmt b1 … bn n -- str"),
-    op(0xEE21, "DECODE2", "fmt str #c1 … #cn n -- count:I2"),
-    op(0xEE22, "ENCODE2", "fmt b1 … bn n -- str"),
+    op(0xEE00, "TIME", "-- a:St", tm.time_),
+    op(0xEE01, "DATE", "-- a:St", tm.date_),
+    op(0xEE02, "CLOCK", "-- a:I4", tm.clock),
+    op(0xEE03, "STIME", "a:St --", tm.stime),
+    op(0xEE04, "SDATE", "a:St --", tm.sdate),
+    op(0xEE05, "CLRCLK", "--", tm.clrclk),
+    op(0xEE06, "PACKTM", "h m s -- d:St", tm.packtm),
+    op(0xEE07, "UNPKTM", "a:St -- h m s", tm.unpktm),
+    op(0xEE08, "PACKDT", "y mo d -- s:St", tm.packdt),
+    op(0xEE09, "UNPKDT", "a:St -- y mo d", tm.unpkdt),
+    op(0xEE0A, "CNFG", "port flow speed fmt --", io.cnfg),
+    op(0xEE0B, "DOUT", "port data --", io.dout),
+    op(0xEE0C, "DIN", "port -- data", io.din),
+    op(0xEE0D, "IOWAIT", "port mask cond timeout -- masked tflag", io.iowait),
+    op(0xEE0E, "ACT", "level --", it.act),
+    op(0xEE0F, "ACTRS", "level --", it.actrs),
+    op(0xEE10, "REACT", "--", it.react),
+    op(0xEE11, "ACTCODE", "code level detproc --", it.actcode),
+    op(0xEE12, "ACTION", "code handler --", it.action),
+    op(0xEE13, "TIMER", "timeout --", it.timer),
+    op(0xEE14, "RTIMER", "--", it.rtimer),
+    op(0xEE15, "TACTION", "handler --", it.taction),
+    op(0xEE16, "FSTAT", "file -- status:I2", fl.fstat),
+    op(0xEE17, "OUTPUT", "file data --", fl.output),
+    op(0xEE18, "INPUT", "file -- data", fl.input_),
+    op(0xEE19, "LOUTPUT", "file data --", fl.loutput),
+    op(0xEE1A, "LINPUT", "file #t -- data:t", fl.linput),
+    op(0xEE1B, "FOPEN", "file mode --", fl.fopen),
+    op(0xEE1C, "FCLOSE", "file --", fl.fclose),
+    op(0xEE1D, "PUTC", "file ch --", fl.putc),
+    op(0xEE1E, "GETC", "file -- ch:I2", fl.getc),
+    op(0xEE1F, "DECODE1", "str #t -- value", fm.decode1),
+    op(0xEE20, "ENCODE1", "fmt b1 … bn n -- str", fm.encode1),
+    op(0xEE21, "DECODE2", "fmt str #c1 … #cn n -- count:I2", fm.decode2),
+    op(0xEE22, "ENCODE2", "fmt b1 … bn n -- str", fm.encode2),
     op(0xED00, "JSPEED", "ratio -- err:I2"),
     op(0xED01, "SPEED", "v -- err:I2"),
     op(0xED02, "ACCEL1", "acc -- err:I2"),

@@ -52,9 +52,10 @@ class Frame:
 
 
 class Process:
-    """A unit of execution inside the VM; number 0 is the program from the input stream."""
+    """A unit of execution inside the VM; number 0 is the program from the input stream, an
+    interrupt process has a label (``timer interrupt``) in place of a number."""
 
-    def __init__(self, number: int, frame: Frame, scopes: list[Scope]) -> None:
+    def __init__(self, number: int | str, frame: Frame, scopes: list[Scope]) -> None:
         self.number = number
         self.stack: list = []
         self.returns: list = []            # ('call', caller frame) or ('bal', pc)
@@ -69,7 +70,14 @@ class Process:
         self.blocked_at = RETRY            # VM generation when it last had to wait
         self.last_run = 0
         self.event_buffer: list[int] = []
+        self.wake_at: float | None = None  # a waiting process looks again at this host time
+        self.timed: tuple | None = None    # ((frame, pc), end) of the timed wait it is in
         self.push = self.stack.append
+
+    @property
+    def name(self) -> str:
+        """How reports name it: ``process 3``, or an interrupt process by its label."""
+        return f"process {self.number}" if isinstance(self.number, int) else str(self.number)
 
     def pop(self):
         try:

@@ -11,11 +11,13 @@ from .codec import CodeKind, decode, decode_function
 from .codes import Function, Num, UserCode, is_user_code, user_code_of, user_key
 from .errors import ExceptionKind as K, StrolicError, fail
 from .host import Host
+from .interrupts import Interrupts
 from .process import (BUILTIN, CYCLE_WAIT, INDIRECT, PUSH, USER, WAIT, Frame, Process,
                       State)
 from .variables import Scope, find
 
 SLICE = 200              # instructions a process runs before the scheduler looks again
+INTERRUPT_PRIORITY = float("-inf")   # interrupt processes go before every process
 DEFAULT_EPS = 1e-6
 
 
@@ -35,6 +37,7 @@ class VM:
         self.executed = 0                  # instructions of the current run (budget)
         self.budget: int | None = None
         self.main: Process | None = None   # process 0, the program of the current run
+        self.files: dict = {}              # file number → open file (functions/system_files.py)
         self.reset()
 
     # ---- state ----------------------------------------------------------------------------------
@@ -47,10 +50,40 @@ class VM:
         self.elbow = 0.0                   # arm angle of a 7-axis arm, degree
         self.flags: set[int] = set()       # event flags that are on
         self.channels: dict[int, object] = {}
-        self.processes: dict[int, Process] = {}
+        self.processes: dict[int | str, Process] = {}
+        self.interrupts = Interrupts()
+        self.close_files()
+
+    def close_files(self, report: bool = False) -> None:
+        """At INIT and at the end of every run: the files the program left open are closed;
+        with ``report`` (a run that ended normally) a failure is raised once all are closed."""
+        files, self.files = self.files, {}
+        failure = None
+        for file in files.values():
+            try:
+                file.close()
+            except StrolicError as error:
+                failure = failure or error
+        if failure is not None and report:
+            raise failure
 
     def changed(self) -> None:
         self.generation += 1
+
+    def timed_wait(self, proc: Process, seconds: float, poll: float | None = None):
+        """For a blocking function that gives up after ``seconds`` (∞: never): ``None`` once that
+        time has passed since its first attempt, else ``WAIT``, the process looking again when
+        something changes, after ``poll`` seconds (a condition outside the VM) or at the end."""
+        key = (proc.frame, proc.frame.pc)
+        now = self.host.now()
+        if proc.timed is None or proc.timed[0] != key:
+            proc.timed = (key, now + seconds)
+        end = proc.timed[1]
+        if now >= end:
+            proc.timed = None
+            return None
+        proc.wake_at = min(end, now + poll) if poll is not None else end
+        return WAIT
 
     def scopes_for_new_process(self) -> list[Scope]:
         return [self.globals]
@@ -94,14 +127,18 @@ class VM:
         self.executed = 0
         try:
             while main.state is not State.DONE:
+                self.interrupts.poll(self)
                 proc = self._pick()
                 if proc is None:
                     self._idle()
                     continue
                 self._execute(proc, SLICE)
+            self.close_files(report=True)
         except StrolicError as error:
             self.host.stop(error)
             raise
+        finally:
+            self.close_files()
         return main
 
     def _eligible(self, proc: Process, now: float | None) -> bool:
@@ -110,28 +147,42 @@ class VM:
         if proc.state is State.WAITING:
             if proc.period and proc.blocked_at == CYCLE_WAIT:
                 return now is not None and now >= proc.next_start
+            if proc.wake_at is not None and now is not None and now >= proc.wake_at:
+                return True
             return proc.blocked_at != self.generation
         return False
 
     def _pick(self) -> Process | None:
-        cyclic = any(p.period for p in self.processes.values())
-        now = self.host.now() if cyclic else None
+        timed = any(p.period or p.wake_at is not None for p in self.processes.values())
+        now = self.host.now() if timed else None
         best = None
         for proc in self.processes.values():
             if self._eligible(proc, now) and (best is None or (proc.priority, proc.last_run)
                                               < (best.priority, best.last_run)):
                 best = proc
         if best is not None and best.state is State.WAITING:
+            best.wake_at = None
             if best.blocked_at == CYCLE_WAIT:
                 best.restart()
             else:
                 best.state = State.RUNNING
         return best
 
+    def _due_times(self) -> list[float]:
+        """Host times at which a waiting process may proceed (cyclic starts, timed waits)."""
+        due = []
+        for proc in self.processes.values():
+            if proc.state is State.WAITING:
+                if proc.blocked_at == CYCLE_WAIT:
+                    due.append(proc.next_start)
+                elif proc.wake_at is not None:
+                    due.append(proc.wake_at)
+        return due
+
     def _idle(self) -> None:
-        """Nothing can run: sleep until a cyclic start is due, or report the deadlock."""
-        due = [p.next_start for p in self.processes.values()
-               if p.state is State.WAITING and p.blocked_at == CYCLE_WAIT]
+        """Nothing can run: sleep until a cyclic start or timed wait is due, or report the
+        deadlock."""
+        due = self._due_times() + self.interrupts.due(self, self.host.now())
         if not due:
             frame = self.main.frame
             code = frame.codes[frame.pc] if frame.pc < len(frame.codes) else None
@@ -141,7 +192,8 @@ class VM:
 
     def finish(self, proc: Process) -> None:
         """A process's root function returned: wait for its next cycle or end."""
-        self.changed()
+        if self.processes.get(proc.number) is proc:    # not an interrupt detection procedure
+            self.changed()
         if proc.period:
             proc.state = State.WAITING
             proc.blocked_at = CYCLE_WAIT
@@ -212,8 +264,35 @@ class VM:
         if frame.function is not None:
             name += f" (in function {frame.name})"
         if proc.number:
-            name += f" (process {proc.number})"
+            name += f" ({proc.name})"
         return error.located(name, frame.origin + offset)
+
+    # ---- interrupt processes (interrupts.py) ----------------------------------------------------
+    def handler_running(self, label: str) -> bool:
+        proc = self.processes.get(label)
+        return proc is not None and proc.state is not State.DONE
+
+    def start_handler(self, label: str, function: Function) -> None:
+        """An interrupt's action as a process that goes before every other."""
+        proc = Process(label, self.function_frame(function, label),
+                       self.scopes_for_new_process())
+        proc.priority = INTERRUPT_PRIORITY
+        self.processes[label] = proc
+        self.changed()
+
+    def detect(self, function: Function, label: str) -> bool:
+        """Run an interrupt detection procedure to its end: is its result true?"""
+        proc = Process(f"{label} detection", self.function_frame(function, label),
+                       self.scopes_for_new_process())
+        while proc.state is State.RUNNING:
+            self._execute(proc, SLICE)
+        if proc.state is not State.DONE:
+            raise StrolicError(K.DETECTION_WAITED, "it must end without waiting",
+                               function=proc.name, offset=function.origin)
+        if not proc.stack or not isinstance(proc.stack[-1], Num):
+            raise StrolicError(K.TYPE_MISMATCH, "an interrupt detection procedure must leave "
+                               "a logical value", function=proc.name, offset=function.origin)
+        return proc.stack[-1].value != 0
 
     # ---- frames and calls -----------------------------------------------------------------------
     def fall_off(self, proc: Process) -> None:

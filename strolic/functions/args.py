@@ -6,9 +6,11 @@ decides the result (MOD, AND, INC …) must be integers, a real there is a type 
 """
 from __future__ import annotations
 
-from ..codes import REAL_TAGS, Num, TagHead, UserCode, round_half_away, type_name
+from ..codes import (REAL_TAGS, Function, Num, TagHead, UserCode, round_half_away, type_name,
+                     user_key)
 from ..errors import ExceptionKind as K, fail
 from ..process import Process
+from ..variables import find
 
 
 def expect(value: object, cls: type | tuple, what: str) -> object:
@@ -69,3 +71,12 @@ def pop_many(proc: Process, count: int) -> list:
     items = proc.stack[len(proc.stack) - count:]
     del proc.stack[len(proc.stack) - count:]
     return items
+
+
+def function_of(proc: Process, item) -> Function | None:
+    """A function given as the datum or as ``#u`` of a user code holding one (FXQT, ACTION …);
+    None when it is neither."""
+    if isinstance(item, UserCode):
+        binding = find(proc.scopes, user_key(item.code))
+        item = binding.value() if binding.defined else None
+    return item if isinstance(item, Function) else None

@@ -8,11 +8,11 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ..codes import I2, Function, Num, UserCode, user_key
+from ..codes import I2, Num, user_key
 from ..errors import ExceptionKind as K, fail
 from ..process import CYCLE_WAIT, RETRY, WAIT, Process, State
 from ..variables import find
-from .args import expect, integer_value, pop_count, pop_many, pop_num, pop_user
+from .args import expect, function_of, integer_value, pop_count, pop_many, pop_num, pop_user
 
 if TYPE_CHECKING:
     from ..vm import VM
@@ -30,11 +30,8 @@ def _process(vm, number: int) -> Process | None:
 def fxqt(vm: VM, proc: Process) -> None:
     """FXQT #a b: 0 started, −1 a is not a function, −2 number not usable (≤ 0 or busy)."""
     number = pop_count(proc)
-    target = proc.pop()
-    if isinstance(target, UserCode):
-        binding = find(proc.scopes, user_key(target.code))
-        target = binding.value() if binding.defined else None
-    if not isinstance(target, Function):
+    target = function_of(proc, proc.pop())
+    if target is None:
         proc.push(Num(I2, -1))
         return
     running = _process(vm, number)

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import sys
+from datetime import datetime
 from pathlib import Path
 
 import pytest
@@ -24,14 +25,48 @@ VAR #x #y #f #g #h DCL
 
 
 class RecordingHost(Host):
-    """A host that keeps console lines and uses a settable clock."""
+    """A host that keeps console lines; its time of day stands still at 2024/05/06 07:08:09."""
 
     def __init__(self) -> None:
         super().__init__()
         self.lines: list[str] = []
+        self.wall = datetime(2024, 5, 6, 7, 8, 9)
 
     def console(self, text: str) -> None:
         self.lines.append(text)
+
+    def wall_clock(self) -> datetime:
+        return self.wall
+
+    def set_wall_clock(self, value: datetime) -> None:
+        self.wall = value
+
+
+class ClockHost(RecordingHost):
+    """A recording host whose clock moves only when the VM sleeps (exact timings)."""
+
+    time = 0.0
+
+    def now(self) -> float:
+        return self.time
+
+    def sleep(self, seconds: float) -> None:
+        self.time += max(seconds, 0.0)
+
+
+def case_host(directory: Path) -> RecordingHost:
+    """The host of the case table (strolic_cases.py). Its program directory is
+    ``directory/program`` (file N is ``fileN.txt``), with a subdirectory ``sub``; a symbolic link
+    ``out`` leads to ``directory/outside``. File 7 is named ``../outside.txt``, 8 an absolute
+    path, 9 ``out/x.txt`` (through the link), 10 ``sub/data.txt``, 11 ``sub`` (a directory)."""
+    host = RecordingHost()
+    host.file_root = directory / "program"
+    (host.file_root / "sub").mkdir(parents=True)
+    (directory / "outside").mkdir()
+    (host.file_root / "out").symlink_to(directory / "outside", target_is_directory=True)
+    host.files.update({7: "../outside.txt", 8: str(directory / "outside" / "abs.txt"),
+                       9: "out/x.txt", 10: "sub/data.txt", 11: "sub"})
+    return host
 
 
 def execute(text: str, budget: int | None = 200_000, host: Host | None = None, **vm_options):

@@ -1,10 +1,12 @@
-"""Table of cases for every built-in function EF00–EF8E: normal cases, type promotion, and the
-exceptions the standard lists. Keys are mnemonics; this table is also the coverage table
-(``test_strolic_coverage.py`` checks that no function of the opcode table is missing).
+"""Table of cases for every built-in function EF00–EF8E and system function EE00–EE22: normal
+cases, type promotion, and the exceptions the standard lists. Keys are mnemonics; this table is
+also the coverage table (``test_strolic_coverage.py`` checks that no function is missing).
 
-A case is ``(program, expected)``: the expected final stack in the text form (bottom first), or
-the ExceptionKind that must stop the program. Programs run after ``conftest.PRELUDE``, which
-names and declares x, y, f, g, h.
+A case is ``(program, expected)``: the expected final stack in the text form (bottom first), the
+same inside ``Warns(...)`` when the program must also print a console warning (and otherwise it
+must not), or the ExceptionKind that must stop the program. Programs run after
+``conftest.PRELUDE``, which names and declares x, y, f, g, h, on ``conftest.case_host``: its
+time of day stands at 2024/05/06 07:08:09.
 """
 from __future__ import annotations
 
@@ -13,12 +15,24 @@ from strolic.errors import ExceptionKind as K
 OVF, UNF, DIV0 = K.NUMERIC_OVERFLOW, K.NUMERIC_UNDERFLOW, K.DIVISION_BY_ZERO
 TYPE, UNDEF, UNDER = K.TYPE_MISMATCH, K.UNDEFINED_DATA, K.STACK_UNDERFLOW
 AREA, BRANCH, DEAD = K.AREA_ERROR, K.BRANCH_OUT_OF_FUNCTION, K.DEADLOCK
+FILE, OUTSIDE, CONVERSION = K.FILE_ERROR, K.FILE_OUTSIDE, K.CONVERSION_ERROR
 T, F = "I2:1", "I2:0"          # logical values
+READ1 = "1 FCLOSE 1 1 FOPEN"   # after writing file 1: read it from the start
+IRQ = ("#x 0 STORE #g Fn{ 1 DIN 1 AND END } STORE #h Fn{ #x x INC STORE 9 ESIG END } STORE "
+       "5 1 #g ACTCODE 5 #h ACTION")
+TICK = "#h Fn{ #x x INC STORE 9 ESIG END } STORE"    # a timer action
+PAUSE = "2 1 1 5 IOWAIT DROP DROP"                   # 5 ms on an input that stays off
+
+
+class Warns(list):
+    """The expected stack of a case that must also print a console warning."""
+
 
 ID = "Trn(0 0 0 1 0 0 0 1 0 0 0 1)"
 T1 = "Trn(10 20 30 1 0 0 0 1 0 0 0 1)"
 RZ90 = "Trn(0 0 0 0 1 0 -1 0 0 0 0 1)"          # rotation of 90° about z
 FMT_T1 = "Trn(10.0 20.0 30.0 1.0 0.0 0.0 0.0 1.0 0.0 0.0 0.0 1.0)"
+FMT_ID = "Trn(0.0 0.0 0.0 1.0 0.0 0.0 0.0 1.0 0.0 0.0 0.0 1.0)"
 POSE_ZERO = " ".join(["0.0"] * 12) + " I2:0 0.0"  # the 14 pose elements
 FN_WAIT = "#f Fn{ 1 EWAIT END } STORE"            # a process that waits for flag 1
 
@@ -309,6 +323,173 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
               "1 CHIN 1 CHIN 1 CHIN", ["1", "2", "3"])],
     "CHOUT": [("1 5 CHOUT 1 6 CHOUT", DEAD), ("1 5 CHOUT 1 CHIN 1 6 CHOUT 1 CHIN", ["5", "6"])],
     "SHARE": [("#x 3 SHARE 1", ["1"]), ("#%2000 1 SHARE", UNDEF), ("5 1 SHARE", TYPE)],
+    # ---- EE: time of day, date, internal clock --------------------------------------------------
+    "TIME": [("TIME", ['"07:08:09"'])],
+    "DATE": [("DATE", ['"2024/05/06"'])],
+    "CLOCK": [("CLOCK 0 GEQ", [T]), ("#x CLOCK STORE #x ASIZE", ["I2:4"])],
+    "STIME": [('"23:59:58" STIME TIME', ['"23:59:58"']), ('"00:00:00" STIME TIME DATE',
+               ['"00:00:00"', '"2024/05/06"']),
+              ('"24:00:00" STIME TIME', Warns(['"07:08:09"'])),
+              ('"7:08:09" STIME TIME', Warns(['"07:08:09"'])),
+              ('"07:08:09:10" STIME TIME', Warns(['"07:08:09"'])), ("1 STIME", TYPE)],
+    "SDATE": [('"2023/12/31" SDATE DATE TIME', ['"2023/12/31"', '"07:08:09"']),
+              ('"2023/02/29" SDATE DATE', Warns(['"2024/05/06"'])),
+              ('"2023-12-31" SDATE DATE', Warns(['"2024/05/06"'])),
+              ('"2101/01/01" SDATE DATE', Warns(['"2024/05/06"'])), ("SDATE", UNDER)],
+    "CLRCLK": [("CLRCLK CLOCK 1000 LT", [T])],
+    "PACKTM": [("7 8 9 PACKTM", ['"07:08:09"']), ("23.4 59 0.5 PACKTM", ['"23:59:01"']),
+               ("23.6 60 -1 PACKTM", ['"00:00:00"']), ("I4:70000 30 30 PACKTM", ['"00:30:30"']),
+               ('"7" 8 9 PACKTM', TYPE), ("8 9 PACKTM", UNDER)],
+    "UNPKTM": [('"07:08:09" UNPKTM', ["I2:7", "I2:8", "I2:9"]),
+               ('"25:08:x" UNPKTM', [F, "I2:8", F]), ('"12:34" UNPKTM', ["I2:12", "I2:34", F]),
+               ('"" UNPKTM', [F, F, F]), ("1 UNPKTM", TYPE)],
+    "PACKDT": [("I2:2024 5 6 PACKDT", ['"2024/05/06"']), ("I2:1800 13 0 PACKDT", ['"1900/01/01"']),
+               ("I2:2024 2 31 PACKDT", ['"2024/02/31"']), ("2000.4 1.5 9 PACKDT", ['"2000/02/09"'])],
+    "UNPKDT": [('"2024/05/06" UNPKDT', ["2024", "I2:5", "I2:6"]),
+               ('"99/5/6" UNPKDT', ["1900", T, T]), ('"2024/13/32" UNPKDT', ["2024", T, T]),
+               ("Vec(1 2 3) UNPKDT", TYPE)],
+    # ---- EE: communication ports, digital I/O (the host's in-memory ports: 1–8 are 8 bits wide,
+    # 9–16 are 16 bits, DIN reads what DOUT wrote; communication ports 1 and 2) ---------------
+    "CNFG": [("1 3 5 0x2D CNFG 2 0 1 3 CNFG 1", ["1"]), ("1 4 5 1 CNFG", Warns([])),
+             ("1 0 7 1 CNFG", Warns([])), ("1 0 5 0 CNFG", Warns([])),
+             ("1 0 5 0x41 CNFG", Warns([])), ("9 0 5 1 CNFG", Warns([])),
+             ('"1" 0 5 1 CNFG', TYPE), ("0 5 1 CNFG", UNDER)],
+    "DOUT": [("1 I2:0x1FF DOUT 1 DIN", ["255"]), ("9 I2:-1 DOUT 9 DIN", ["I2:-1"]),
+             ("9 I4:0x12345 DOUT 9 DIN", ["9029"]), ("1.4 5 DOUT 1 DIN", ["I2:5"]),
+             ("99 5 DOUT 1", Warns(["1"])), ("1 5.0 DOUT", TYPE), ("5 DOUT", UNDER)],
+    "DIN": [("3 DIN", [F]), ("16 DIN", [F]), ("99 DIN", Warns([F])), ("0 DIN", Warns([F])),
+            ('"a" DIN', TYPE)],
+    "IOWAIT": [("1 6 DOUT 1 4 1 0 IOWAIT", ["I2:4", F]), ("1 6 DOUT 1 5 1 0 IOWAIT", ["I2:4", T]),
+               ("1 6 DOUT 1 5 2 0 IOWAIT", ["I2:4", F]), ("1 1 1 5 IOWAIT", [F, T]),
+               ("1 1 1 R4:2.5 IOWAIT", [F, T]), ("9 I2:-1 DOUT 9 I2:-32768 1 0 IOWAIT",
+                                                 ["-32768", F]),
+               ("#f Fn{ 1 8 DOUT END } STORE #f 1 FXQT DROP 1 8 1 -1 IOWAIT", ["I2:8", F]),
+               ("#f Fn{ 1 8 DOUT END } STORE #f 1 FXQT DROP 1 12 2 1000 IOWAIT", ["I2:8", F]),
+               ("99 1 1 0 IOWAIT", Warns([F, T])), ("1 1 3 0 IOWAIT", UNDEF),
+               ("1 1.0 1 0 IOWAIT", TYPE), ("1 1 1 \"a\" IOWAIT", TYPE), ("1 1 0 IOWAIT", UNDER)],
+    # ---- EE: files (see conftest.case_host: files 7, 8, 9 lie outside the program directory;
+    # files 101, 102 are communication ports 1, 2 with a loopback plug) ------------------------
+    "FOPEN": [("1 2 FOPEN 1 5 OUTPUT 1 FCLOSE 1 1 FOPEN 1 INPUT", ["5"]),
+              (f"1 2 FOPEN 1 5 OUTPUT 1 FCLOSE 1 4 FOPEN 1 6 OUTPUT {READ1} 1 INPUT 1 INPUT",
+               ["5", "6"]),
+              (f"1 2 FOPEN 1 5 OUTPUT 1 FCLOSE 1 2 FOPEN {READ1} 1 FSTAT", [T]),
+              ("10 2 FOPEN 10 FSTAT", [F]), ("1.4 2 FOPEN 1 FSTAT", [F]),
+              ("1 1 FOPEN", FILE), ("1 3 FOPEN", FILE), ("1 2 FOPEN 1 2 FOPEN", FILE),
+              ("0 2 FOPEN", FILE), ("11 1 FOPEN", FILE), ("7 2 FOPEN", OUTSIDE),
+              ("8 2 FOPEN", OUTSIDE), ("9 2 FOPEN", OUTSIDE), ('"a" 2 FOPEN', TYPE)],
+    "FCLOSE": [("1 2 FOPEN 1 FCLOSE 1 FSTAT", ["I2:2"]), ("1 FCLOSE", FILE)],
+    "FSTAT": [("1 FSTAT", ["I2:2"]), (f"1 2 FOPEN {READ1} 1 FSTAT", [T]),
+              (f"1 2 FOPEN 1 7 PUTC {READ1} 1 FSTAT 1 GETC 1 FSTAT", [F, "I2:7", T]),
+              ("1 2 FOPEN 1 FSTAT", [F]), ("FSTAT", UNDER)],
+    "OUTPUT": [(f'1 2 FOPEN 1 5 OUTPUT 1 2.5 OUTPUT 1 "ab" OUTPUT 1 Vec(1 2 3) OUTPUT '
+                f"{READ1} 1 INPUT 1 INPUT 1 INPUT 1 INPUT", ["5", "2.5", '"ab"', "Vec(1.0 2.0 3.0)"]),
+               ("1 5 OUTPUT", FILE), ("1 2 FOPEN 1 #x OUTPUT", TYPE),
+               (f"1 2 FOPEN {READ1} 1 5 OUTPUT", FILE)],
+    "INPUT": [(f'1 2 FOPEN 1 I2:300 OUTPUT 1 -1e3 OUTPUT 1 "a b" LOUTPUT 1 Ar[I2 1 2] OUTPUT '
+               f"{READ1} 1 INPUT 1 INPUT 1 INPUT 1 INPUT 1 INPUT",
+               ["300", "-1000.0", '"a"', '"b"', "Ar[I2 1 2]"]),
+              (f'1 2 FOPEN 1 "x<y" OUTPUT 1 "\\"q\\"" OUTPUT {READ1} 1 INPUT 1 INPUT',
+               ['"x<y"', '"q"']),
+              (f"1 2 FOPEN {READ1} 1 INPUT", FILE), ("1 INPUT", FILE),
+              ("1 2 FOPEN 1 INPUT", FILE)],
+    "LOUTPUT": [(f'1 2 FOPEN 1 "x y" LOUTPUT 1 3 LOUTPUT {READ1} 1 #St(0) LINPUT '
+                 "1 #I2 LINPUT", ['"x y"', "I2:3"]), ("1 1 LOUTPUT", FILE)],
+    "LINPUT": [(f'1 2 FOPEN 1 "1, 2, 3" LOUTPUT {READ1} 1 #Vec LINPUT',
+                ["Vec(1.0 2.0 3.0)"]),
+               (f"1 2 FOPEN 1 55 PUTC 1 13 PUTC 1 10 PUTC {READ1} 1 #St(0) LINPUT",
+                ['"7"']),
+               (f"1 2 FOPEN 1 55 PUTC {READ1} 1 #I4 LINPUT", ["I4:7"]),
+               (f'1 2 FOPEN 1 "abc" LOUTPUT {READ1} 1 #I2 LINPUT', CONVERSION),
+               (f"1 2 FOPEN {READ1} 1 #St(0) LINPUT", FILE), ("1 #I2 LINPUT", FILE),
+               ("1 2 LINPUT", TYPE)],
+    "PUTC": [(f"1 2 FOPEN 1 I2:321 PUTC {READ1} 1 GETC", ["I2:65"]),
+             ("1 65 PUTC", FILE), ("1 65.0 PUTC", TYPE)],
+    "GETC": [("101 2 FOPEN 101 72 PUTC 101 FCLOSE 101 1 FOPEN 101 GETC 101 FSTAT", ["I2:72", T]),
+             (f"1 2 FOPEN {READ1} 1 GETC", FILE), ("1 GETC", FILE)],
+    # ---- EE: format conversion (Annex 2) -------------------------------------------------------
+    "DECODE1": [('" 42 " #I2 DECODE1', ["I2:42"]), ('"2.6" #I1 DECODE1', ["3"]),
+                ('"1e3" #R4 DECODE1', ["R4:1000.0"]), ('"-.5" #R8 DECODE1', ["-0.5"]),
+                ('"a b" #St(0) DECODE1', ['"a b"']), ('"ab" #Rd(0) DECODE1', ["Rd<6162>"]),
+                ('"1,2 3" #Vec DECODE1', ["Vec(1.0 2.0 3.0)"]),
+                ('"Vec(1 2 3)" #Vec DECODE1', ["Vec(1.0 2.0 3.0)"]),
+                ('"1 2 3" #Ar(0, I4) DECODE1', ["Ar[I4 1 2 3]"]),
+                ('"0 0 0 1 0 0 0 1 0 0 0 1 1 0" #Pm(0) DECODE1 TRN', [FMT_ID]),
+                ('"12x" #I2 DECODE1', CONVERSION), ('"300" #I1 DECODE1', CONVERSION),
+                ('"1 2" #Vec DECODE1', CONVERSION), ('"1" #Fn(0) DECODE1', CONVERSION),
+                ('"Vec(1 2 3)" #Trn DECODE1', CONVERSION),
+                ("5 #I2 DECODE1", TYPE), ('"5" 5 DECODE1', TYPE)],
+    "ENCODE1": [('"###" 5 1 ENCODE1', ['"  5"']), ('"###.##" 3.14159 1 ENCODE1', ['"  3.14"']),
+                ('"#.## %.##" 0.5 0.5 2 ENCODE1', ['" .50 0.50"']),
+                ('"-### +###" -5 5 2 ENCODE1', ['"  -5   +5"']),
+                ('"--##.#" -123.45 1 ENCODE1', ['"-123.5"']),
+                ('"###,###" I2:12345 1 ENCODE1', ['" 12,345"']),
+                ('"**##|%%%" 5 7 2 ENCODE1', ['"***5|007"']),
+                ('"-%.#####^^^^" -12.5 1 ENCODE1', ['"-1.25000E+01"']),
+                ('"<<<<|>>>>|####" "ab" "ab" "ab" 3 ENCODE1', ['"ab  |  ab| ab "']),
+                ('"X=## " Vec(1 2 3) 1 ENCODE1', ['"X= 1 X= 2 X= 3 "']),
+                ('"A=##, B=##." 1 1 ENCODE1', ['"A= 1, B="']), ('"none" 0 ENCODE1', ['"none"']),
+                ('"###" 1000 1 ENCODE1', CONVERSION), ('"###" -5 1 ENCODE1', CONVERSION),
+                ('"<<" "abc" 1 ENCODE1', CONVERSION), ('"<<" 1 1 ENCODE1', CONVERSION),
+                ('"#.#" "a" 1 ENCODE1', CONVERSION), ('"text" 1 1 ENCODE1', CONVERSION),
+                ('"###" #x 1 ENCODE1', CONVERSION), ("5 0 ENCODE1", TYPE),
+                ('"###" 1 2 ENCODE1', UNDER)],
+    "ENCODE2": [('"%5d|%-5d|%05.1f" 42 -3 3.14159 3 ENCODE2', ['"   42|-3   |003.1"']),
+                ('"%x %X %#o %o" -1 I2:255 8 0 4 ENCODE2', ['"ff FF 010 0"']),
+                ('"%c%s %e %g %%" 65 "hi" 12345.678 0.0001 4 ENCODE2',
+                 ['"Ahi 1.234568e+04 0.0001 %"']),
+                ('"%*d|%.*f|%ld|%hu|%i" 3 7 2 3.14159 5 -7 9.6 7 ENCODE2',
+                 ['"  7|3.14|5|-7|10"']),
+                ('"%d" 1 2 2 ENCODE2', ['"1"']), ('"%s" Ar[St(2) "ab" "cd"] 1 ENCODE2', ['"ab"']),
+                ('"%d %d" 1 1 ENCODE2', CONVERSION), ('"%q" 1 1 ENCODE2', CONVERSION),
+                ('"%d" "a" 1 ENCODE2', CONVERSION), ('"%s" 1 1 ENCODE2', CONVERSION),
+                ('"%n" 1 1 ENCODE2', CONVERSION), ('5 0 ENCODE2', TYPE)],
+    "DECODE2": [('"%d,%f" "3,4.5" #x #y 2 DECODE2 x y', ["I2:2", "I4:3", "4.5"]),
+                ('"%s %c%x %[a-c]" "word Zff abcd" #x #y #f #g 4 DECODE2 x y f g',
+                 ["I2:4", '"word"', "I2:90", "I4:255", '"abc"']),
+                ('"%*d %3d%i" " 9 12345 0x1f" #x #y 2 DECODE2 x y', ["I2:2", "I4:123", "I4:45"]),
+                ('"x=%d y=%d" "x=5 y=z" #x #y 2 DECODE2 x', [T, "I4:5"]),
+                ('"%d" "" #x 1 DECODE2', ["I2:-1"]), ('"%d%%" "5%" #x #y 2 DECODE2', [T]),
+                ('"%d %d" "1 2" #x 1 DECODE2', CONVERSION), ('"%q" "1" #x 1 DECODE2', CONVERSION),
+                ('"%2c" "ab" #x 1 DECODE2', CONVERSION),
+                ('"%d" "99999999999" #x 1 DECODE2', CONVERSION),
+                ('"%d" "1" 5 1 DECODE2', TYPE), ('"%d" "1" #%2000 1 DECODE2', UNDEF),
+                ('"%d" 1 #x 1 DECODE2', TYPE)],
+    # ---- EE: interrupts (IRQ: code 5 of level 1 is input 1 bit 0; its action counts in x and
+    # sets flag 9) and the timer interrupt ------------------------------------------------------
+    "ACT": [(f"{IRQ} 1 ACT 1 1 DOUT 9 EWAIT x", ["1"]), (f"{IRQ} 1 1 DOUT {PAUSE} x", ["0"]),
+            (f"{IRQ} 2 ACT 1 1 DOUT {PAUSE} x", ["0"]), ("0 ACT", UNDEF), ("1.0 ACT", TYPE)],
+    "ACTRS": [(f"{IRQ} 1 ACT 1 ACTRS 1 1 DOUT {PAUSE} x", ["0"]),
+              (f"{IRQ} 1 ACT 2 ACT 0 ACTRS 1 1 DOUT {PAUSE} x", ["0"]),
+              (f"{IRQ} 1 ACT 2 ACTRS 1 1 DOUT 9 EWAIT x", ["1"]), ("-1 ACTRS", UNDEF)],
+    "REACT": [(f"{IRQ} 1 ACT 1 ACTRS REACT 1 1 DOUT 9 EWAIT x", ["1"]),
+              (f"{IRQ} 1 ACT 2 ACT 0 ACTRS REACT 1 1 DOUT 9 EWAIT x", ["1"]),
+              (f"{IRQ} 1 ACT 1 ACTRS REACT REACT 1 ACTRS REACT 2 ACTRS REACT 1 1 DOUT 9 EWAIT x",
+               ["1"]),
+              (f"{IRQ} 1 ACT 1 1 DOUT 9 EWAIT {PAUSE} x", ["1"]),
+              ("#x 0 STORE 5 1 Fn{ 1 END } ACTCODE "
+               "5 Fn{ #x x INC STORE x 3 LT >r BRT 9 ESIG END r: REACT END } ACTION "
+               "1 ACT 9 EWAIT x", ["3"])],
+    "ACTCODE": [("5 1 Fn{ 1 END } ACTCODE 5 Fn{ 9 ESIG END } ACTION 1 ACT 9 EWAIT 7", ["7"]),
+                (f"{IRQ} 5 3 #g ACTCODE 1 ACT 1 1 DOUT {PAUSE} 3 ACT 9 EWAIT x", ["1"]),
+                ("5 1 7 ACTCODE", TYPE), ("5 0 Fn{ 1 END } ACTCODE", UNDEF), ("5.0 1 Fn{ 1 END } ACTCODE", TYPE),
+                ("#g Fn{ END } STORE 5 1 #g ACTCODE 5 #g ACTION 1 ACT 9 EWAIT", TYPE),
+                ("5 1 Fn{ 3 EWAIT 1 END } ACTCODE 5 Fn{ END } ACTION 1 ACT 9 EWAIT",
+                 K.DETECTION_WAITED)],
+    "ACTION": [(f"{IRQ} 5 Fn{{ #x 7 STORE 9 ESIG END }} ACTION 1 ACT 1 1 DOUT 9 EWAIT x",
+                ["7"]), ("5 1 Fn{ 1 END } ACTCODE 1 ACT 1 1 2 10 IOWAIT", [F, T]),
+               ("5 7 ACTION", TYPE), ("5 #%2000 ACTION", UNDEF), ("5 #x ACTION", TYPE)],
+    "TIMER": [(f"#x 0 STORE {TICK} #h TACTION 10 TIMER 9 EWAIT x", ["1"]),
+              (f"#x 0 STORE {TICK} #h TACTION R4:2.5 TIMER 9 EWAIT x", ["1"]),
+              (f"#x 0 STORE {TICK} #h TACTION 10 TIMER 0 TIMER {PAUSE} {PAUSE} {PAUSE} x",
+               ["0"]),
+              (f"#x 0 STORE {TICK} #h TACTION 5 TIMER 9 EWAIT {PAUSE} {PAUSE} x", ["1"]),
+              (f"10 TIMER {PAUSE} {PAUSE} {PAUSE} 1", ["1"]), ('"a" TIMER', TYPE)],
+    "RTIMER": [(f"{IRQ} 1 ACT Fn{{ 8 ESIG END }} TACTION 5 TIMER 8 EWAIT 1 1 DOUT {PAUSE} x "
+                "RTIMER 9 EWAIT x", ["0", "1"]),
+               (f"{IRQ} 1 ACT Fn{{ 8 ESIG END }} TACTION 5 TIMER 8 EWAIT RTIMER 1 ACTRS RTIMER "
+                f"1 1 DOUT {PAUSE} x", ["0"])],
+    "TACTION": [(f"#x 0 STORE Fn{{ #x 5 STORE 9 ESIG END }} TACTION 1 TIMER 9 EWAIT x",
+                 ["5"]), ("7 TACTION", TYPE), ("TACTION", UNDER)],
 }
 
 # Exceptions that Annex 1 Table 1 lists in a function's 例外 cell: each must have a case.
@@ -318,4 +499,11 @@ LISTED_EXCEPTIONS: dict[str, K] = {
     "PUSH": UNDEF, "EXTB": AREA, "EMBB": AREA, "EXTE": AREA, "EMBE": AREA,
     "BRA": BRANCH, "BRF": BRANCH, "BRT": BRANCH, "BAL": BRANCH,
     "RET": K.NO_RETURN_DESTINATION, "NPUSH": UNDEF, "NPOP": UNDEF,
+    # EE area: "program stops" on a failing file access or conversion
+    "FOPEN": FILE, "FCLOSE": FILE, "OUTPUT": FILE, "INPUT": FILE, "LOUTPUT": FILE,
+    "LINPUT": FILE, "PUTC": FILE, "GETC": FILE, "DECODE1": CONVERSION, "ENCODE1": CONVERSION,
+    "DECODE2": CONVERSION, "ENCODE2": CONVERSION,
 }
+
+# Functions whose listed exception is a console warning, the program going on (EE area).
+LISTED_WARNINGS = ("STIME", "SDATE", "DOUT", "DIN")

@@ -17,6 +17,7 @@ EXPECTED_STACKS = {
         "R4:5.0", "Vec(0.0 0.0 1.0)", "Vec(-40.0 110.0 30.0)",
         "Trn(0.0 0.0 0.0 1.0 0.0 0.0 0.0 1.0 0.0 0.0 0.0 1.0)", "Vec(-20.0 110.0 30.0)", "1.0"],
     "processes.sasm": ["1", "2", "3", "I2:0"],
+    "io_interrupts.sasm": ["I2:4", '"parts=3 time-out=0"', "I2:0"],
 }
 
 
@@ -89,3 +90,12 @@ def test_asm_and_dis_report_bad_input(tmp_path: Path) -> None:
 def test_missing_file_is_reported_without_a_traceback(tmp_path: Path) -> None:
     result = strolic("run", str(tmp_path / "missing.sasm"))
     assert result.returncode == 2 and "Traceback" not in result.stderr
+
+
+def test_run_uses_the_directory_of_the_program_for_files(tmp_path: Path) -> None:
+    (tmp_path / "file2.txt").write_text("41\n")
+    program = tmp_path / "files.sasm"
+    program.write_text("2 1 FOPEN 3 2 FOPEN 3 2 INPUT INC LOUTPUT\n")
+    result = strolic("run", str(program))
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "file3.txt").read_text() == "42\n"

@@ -1,11 +1,13 @@
-"""The coverage table: no function of the opcode table in EF00–EF8E may be silently missing."""
+"""The coverage table: no function of EF00–EF8E or EE00–EE22 may be silently missing."""
 from __future__ import annotations
 
-from strolic_cases import CASES, LISTED_EXCEPTIONS
+from strolic_cases import CASES, LISTED_EXCEPTIONS, LISTED_WARNINGS, Warns
 from strolic import opcodes
 from strolic.errors import ExceptionKind
 
 EF_MNEMONICS = {row.mnemonic for row in opcodes.TABLE if 0xEF00 <= row.code <= 0xEF8E}
+EE_MNEMONICS = {row.mnemonic for row in opcodes.TABLE if 0xEE00 <= row.code <= 0xEE22}
+COVERED = EF_MNEMONICS | EE_MNEMONICS
 
 
 def test_opcode_table_has_all_143_vm_functions() -> None:
@@ -13,16 +15,22 @@ def test_opcode_table_has_all_143_vm_functions() -> None:
     assert all(row.handler is not None for row in opcodes.VM_FUNCTIONS)
 
 
-def test_every_ef_function_has_a_normal_case() -> None:
-    missing = {m for m in EF_MNEMONICS
+def test_every_function_has_a_normal_case() -> None:
+    missing = {m for m in COVERED
                if not any(not isinstance(expected, ExceptionKind) for _, expected in CASES.get(m, []))}
     assert not missing, f"functions without a normal case: {sorted(missing)}"
-    assert set(CASES) <= EF_MNEMONICS, set(CASES) - EF_MNEMONICS
+    assert set(CASES) <= COVERED, set(CASES) - COVERED
 
 
 def test_every_listed_exception_has_a_case() -> None:
     for mnemonic, kind in LISTED_EXCEPTIONS.items():
         assert any(expected is kind for _, expected in CASES[mnemonic]), (mnemonic, kind)
+
+
+def test_every_listed_warning_has_a_case() -> None:
+    """STIME, SDATE, CNFG, DOUT, DIN: the exception is a console warning, the program goes on."""
+    for mnemonic in LISTED_WARNINGS:
+        assert any(isinstance(expected, Warns) for _, expected in CASES[mnemonic]), mnemonic
 
 
 def test_arithmetic_cases_cover_type_promotion() -> None:
@@ -32,9 +40,11 @@ def test_arithmetic_cases_cover_type_promotion() -> None:
         assert any(":" in program or "." in program for program, _ in CASES[mnemonic]), mnemonic
 
 
-def test_system_and_robot_functions_are_rows_waiting_for_handlers() -> None:
+def test_system_and_robot_function_rows() -> None:
+    """EE rows have handlers that use the host's hooks; ED rows wait for the robot binding."""
     host_rows = [row for row in opcodes.TABLE if row.code < 0xEF00]
     assert [row.code for row in host_rows] == (list(range(0xEE00, 0xEE23))
                                                + list(range(0xED00, 0xED24)))
-    assert all(row.handler is None and "--" in row.effect for row in host_rows)
+    assert all("--" in row.effect for row in host_rows)
+    assert all((row.handler is None) == (row.code < 0xEE00) for row in host_rows)
     assert len(opcodes.BY_CODE) == len(opcodes.TABLE) == 143 + 71

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
-from conftest import PRELUDE, RecordingHost, error_of, execute, stack_of
+from conftest import PRELUDE, ClockHost, RecordingHost, error_of, execute, stack_of
 from strolic.codec import encode
 from strolic.codes import Num, I2
 from strolic.errors import ExceptionKind as K, StrolicError
@@ -164,12 +164,22 @@ def test_a_function_datum_can_be_started_directly() -> None:
 
 
 # ---- executing generated programs never fails with anything but a STROLIC exception ----------
+class ImpatientHost(ClockHost):
+    """Waits (IOWAIT, TIMER) pass in no time; a minute of them stops the program."""
+
+    def sleep(self, seconds: float) -> None:
+        super().sleep(seconds)
+        if self.time > 60:
+            raise StrolicError(K.DEADLOCK, "waited a minute for an input or a timer")
+
+
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(program_codes(), st.integers(0, 3))
 def test_random_programs_stop_only_with_strolic_exceptions(codes, declared) -> None:
     prelude = assemble("VAR #%1000 #%1001 #%1002 DCL #%1000 #%1001 STORE")
     try:
-        VM(max_stack=1000, max_return_depth=100).run(prelude + encode(codes), budget=5000)
+        VM(ImpatientHost(), max_stack=1000, max_return_depth=100).run(prelude + encode(codes),
+                                                                     budget=5000)
     except StrolicError as error:
         assert error.kind is not K.COMPUTER_ERROR, error.report()
 
@@ -187,16 +197,7 @@ def test_equal_function_bodies_at_different_offsets_branch_correctly() -> None:
 
 
 def test_cyclic_process_runs_every_period_on_the_host_clock() -> None:
-    class Clock(RecordingHost):
-        time = 0.0
-
-        def now(self):
-            return self.time
-
-        def sleep(self, seconds):
-            self.time += seconds
-
-    host = Clock()
+    host = ClockHost()
     program = ("#x 0 STORE #f Fn{ #x x INC STORE x RESULT x 3 GEQ >s BRT END s: 2 ESIG END } "
                "STORE #f 1 FXQT DROP 1 100 FCYCLE DROP 2 EWAIT 1 0 FCYCLE x")
     _, main = execute(program, host=host)
