@@ -42,7 +42,7 @@ class Simulation:
         if c.rate_hz <= 0 or c.real_time_factor < 0 or c.joint_state_rate_hz <= 0:
             raise ValueError("rate_hz and joint_state_rate_hz must be > 0, real_time_factor >= 0")
         self.world = World(time_step=1.0 / c.rate_hz)
-        self.executor = MotionExecutor(self.world, c.real_time_factor)
+        self.executor = MotionExecutor(self.world, c.real_time_factor, alive=node.context.ok)
         self._clock = node.create_publisher(Clock, "/clock", 10)
         self._joints = node.create_publisher(JointState, "joint_states", 10)
         self.executor.after_step(self._publish_clock)
@@ -78,3 +78,10 @@ class Simulation:
                 n.destroy_node()
             self.world.close()
             rclpy.try_shutdown()
+
+
+def run_alone(node_class: type, args: list[str] | None = None) -> None:
+    """`python -m <node>`: one node with a simulation of its own, until SIGINT/SIGTERM."""
+    rclpy.init(args=sys.argv if args is None else args)
+    node = node_class()
+    node.simulation.spin(node)

@@ -113,11 +113,28 @@ def _first_exit(values: np.ndarray, lower: np.ndarray, upper: np.ndarray,
     return None
 
 
+def _check_config(c: ArmConfig) -> None:
+    """The start-up settings, else ValueError (the node does not start) saying which."""
+    positive = ("accel_time_joint", "min_accel_time_joint", "accel_time_cartesian",
+                "min_accel_time_cartesian", "max_speed_translation", "max_speed_rotation",
+                "gripper_speed")
+    bad = [n for n in positive if not (math.isfinite(getattr(c, n)) and getattr(c, n) > 0)]
+    if bad:
+        raise ValueError(f"{', '.join(bad)} must be finite and > 0")
+    if c.queue_size < 1 or not 0 <= c.initial_speed_ratio <= 100:
+        raise ValueError("queue_size must be >= 1 and initial_speed_ratio within 0 … 100 %")
+    box = np.asarray(c.soft_limit_cartesian, float)
+    if box.shape != (6,) or not np.all(np.isfinite(box)) or np.any(box[0::2] > box[1::2]):
+        raise ValueError("soft_limit_cartesian needs x lower, x upper, y lower, y upper, "
+                         f"z lower, z upper with lower <= upper, got {c.soft_limit_cartesian}")
+
+
 class ArmCore:
     """State, settings and motion queue of the 7-axis arm with its 1-axis gripper."""
 
     def __init__(self, executor: MotionExecutor, config: ArmConfig | None = None) -> None:
         self.config = c = config or ArmConfig()
+        _check_config(c)
         self.executor = executor
         self.kin = shared_kinematics()
         self.planner = CartesianPlanner(self.kin)
@@ -380,8 +397,8 @@ class ArmCore:
         why = self._control_ignored()
         if why is None and self.device.paused:
             why = "already paused"
-        if why is None and self.device.current is None:
-            why = "the arm is not moving"
+        if why is None and (self.device.current is None or self.device.stopping):
+            why = "the arm is not moving" if self.device.current is None else "it is stopping"
         if why is not None:
             return _ignored(why)
         if not self.device.pause(self._current_ramp()):

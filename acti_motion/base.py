@@ -88,6 +88,13 @@ class Path(Protocol):
     def twist(self, t: float) -> tuple[float, float]:
         """(forward speed m/s, yaw rate rad/s) at t; (0, 0) outside [0, duration]."""
 
+    def retimed(self, t: float, limits: "Limits") -> "Path | None":
+        """The rest of the path from t on, timed for new limits from the speed at t (same
+        geometry, same end); None when this kind of path keeps its timing."""
+
+
+Limits = tuple[float, float, float, float]      # (v_max, w_max, a_max, alpha_max) in m, rad, s
+
 
 class Ramp:
     """Time-optimal 1-D profile over `length` >= 0 from speed `v0` >= 0 to rest: accelerate (or
@@ -171,6 +178,10 @@ class CurvePath:
         sd = self.ramp.sample(t)[1]
         return self.unit[0] * sd, self.unit[1] * sd
 
+    def retimed(self, t: float, limits: Limits) -> "CurvePath":
+        s, sd = self.ramp.sample(t) if t < self.duration else (self.ramp.length, 0.0)
+        return CurvePath(self.at_parameter(s), self.unit, self.ramp.length - s, limits, sd)
+
 
 def line(start: Pose2D, distance: float, limits: tuple[float, float, float, float]) -> CurvePath:
     """Straight `distance` m along the heading (negative: backwards)."""
@@ -215,6 +226,37 @@ class Chain:
         path, tau = self._find(t)
         return path.twist(tau)
 
+    def retimed(self, t: float, limits: Limits) -> "Chain":
+        """The running part re-timed from its present speed, the parts after it from rest."""
+        if not self.paths:
+            return self
+        i = min(max(bisect.bisect_right(self.starts, t) - 1, 0), len(self.paths) - 1)
+        head = self.paths[i]
+        parts = [retimed_or_kept(head, t - self.starts[i], limits)]
+        parts += [retimed_or_kept(p, 0.0, limits) for p in self.paths[i + 1:]]
+        return Chain(parts, self.pose(t))
+
+
+class Tail:
+    """A path from time `start` on (the part of a path that keeps its timing)."""
+
+    def __init__(self, path: Path, start: float) -> None:
+        self.path, self.start = path, start
+        self.duration = max(0.0, path.duration - start)
+
+    def pose(self, t: float) -> Pose2D:
+        return self.path.pose(self.start + min(max(t, 0.0), self.duration))
+
+    def twist(self, t: float) -> tuple[float, float]:
+        return self.path.twist(self.start + t) if 0.0 <= t < self.duration else (0.0, 0.0)
+
+
+def retimed_or_kept(path: Path, t: float, limits: Limits) -> Path:
+    new = getattr(path, "retimed", lambda *_: None)(t, limits)
+    if new is not None:
+        return new
+    return path if t <= 0.0 else Tail(path, t)
+
 
 class Moved:
     """A path seen from another frame: pose' = frame ∘ pose (setPosition moves the odometry frame)."""
@@ -228,6 +270,10 @@ class Moved:
 
     def twist(self, t: float) -> tuple[float, float]:
         return self.path.twist(t)
+
+    def retimed(self, t: float, limits: Limits) -> "Moved | None":
+        inner = getattr(self.path, "retimed", lambda *_: None)(t, limits)
+        return None if inner is None else Moved(inner, self.frame)
 
 
 def straight_to(start: Pose2D, goal: Pose2D, limits: tuple[float, float, float, float],
@@ -352,6 +398,14 @@ class TrackedBaseMotion:
 
     def move_frame(self, frame: Pose2D) -> None:
         self.path = Moved(self.path, frame)
+
+    def retime(self, t: float, limits: Limits) -> None:
+        """New velocity or acceleration settings from motion time t on (0: not started)."""
+        local = max(0.0, t - self.t0)
+        if local < self.path.duration:
+            new = getattr(self.path, "retimed", lambda *_: None)(local, limits)
+            if new is not None:
+                self.splice(max(t, self.t0), new)
 
     def apply(self, world: World, t: float, rate: float) -> None:
         if t >= self.duration:

@@ -15,10 +15,9 @@ from dataclasses import dataclass
 from typing import Sequence
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
-from acti_motion.base import (Chain, Odometry, Path, Pose2D, SampledPath, TrackedBaseMotion,
-                              straight_to, turn, velocity_path, wrap_angle)
+from acti_motion.base import (Chain, CurvePath, Odometry, Path, Pose2D, SampledPath,
+                              TrackedBaseMotion, straight_to, turn, velocity_path, wrap_angle)
 
 SAMPLE_DT = 0.005            # s between samples of the timed path
 DENSE_STEP = 0.002           # m between samples of the geometric path
@@ -46,17 +45,23 @@ def _toppra():
 def time_optimal(s: np.ndarray, heading: np.ndarray, limits: tuple[float, float, float, float],
                  v0: float = 0.0, grid_step: float = GRID_STEP, grid_max: int = GRID_MAX):
     """TOPP-RA over the path (s, theta(s)) with the drive's bounds, from speed v0 to rest.
+    A start faster than v_max (the velocity setting was lowered) is let down at a_max.
     The trajectory (callable t → [s, theta], and its derivatives), or None when infeasible."""
     ta = _toppra()
     v_max, w_max, a_max, alpha_max = limits
     keep = np.unique(np.linspace(0, len(s) - 1, min(len(s), 2000)).astype(int))
     path = ta.SplineInterpolator(s[keep], np.column_stack([s[keep], heading[keep]]))
     n = int(min(grid_max, max(20, math.ceil(s[-1] / grid_step))))
-    constraints = [
-        ta.constraint.JointVelocityConstraint(np.array([[-v_max, v_max], [-w_max, w_max]])),
-        ta.constraint.JointAccelerationConstraint(np.array([[-a_max, a_max],
-                                                            [-alpha_max, alpha_max]])),
-    ]
+    if v0 > v_max:
+        def bounds(si: float) -> np.ndarray:
+            v = max(v_max, math.sqrt(max(0.0, v0 * v0 - 2.0 * a_max * si))) * (1 + 1e-6)
+            w = w_max * v / v_max
+            return np.array([[-v, v], [-w, w]])
+        velocity = ta.constraint.JointVelocityConstraintVarying(bounds)
+    else:
+        velocity = ta.constraint.JointVelocityConstraint(np.array([[-v_max, v_max], [-w_max, w_max]]))
+    constraints = [velocity, ta.constraint.JointAccelerationConstraint(
+        np.array([[-a_max, a_max], [-alpha_max, alpha_max]]))]
     instance = ta.algorithm.TOPPRA(constraints, path, gridpoints=np.linspace(0.0, s[-1], n + 1),
                                    parametrizer="ParametrizeConstAccel")
     return instance.compute_trajectory(sd_start=v0, sd_end=0.0)
@@ -66,6 +71,7 @@ def spline_through(start: Pose2D, points: Sequence[tuple[float, float]]):
     """Dense samples of the cubic spline from the start position through `points`, leaving along
     the start heading: (arc length s, x, y, heading, arc length of each point); None if no point
     is farther than MIN_SEPARATION from the one before."""
+    from scipy.interpolate import CubicSpline  # noqa: PLC0415 - lazy, like toppra (0.3 s)
     xy = [(start.x, start.y)]
     index = []                                   # per given point: its row in xy
     for p in points:
@@ -117,55 +123,63 @@ ALIGN_TOLERANCE = math.radians(1.0)   # from rest, turn toward the first point w
 class CruiseMotion(TrackedBaseMotion):
     """moveCruiseAbs: one smooth motion through the points given so far. A point added while it
     runs re-plans the rest of the path from the reference state then (speed continuous), so the
-    base passes every point without stopping and stops only at the last."""
+    base passes every point without stopping and stops only at the last. From rest it first
+    turns toward the first point."""
 
     def __init__(self, odometry: Odometry, start: Pose2D, point: tuple[float, float],
                  limits: tuple[float, float, float, float]) -> None:
-        self.start, self.points, self.limits = start, [point], limits
-        self.via_times: list[float] = []
-        self.from_rest = True
-        super().__init__(odometry, self._plan_from_rest(), "move_cruise_abs")
-
-    def _plan_from_rest(self) -> Path:
-        """Turn in place toward the first point if needed, then the curve through all of them."""
-        start = self.start
-        first = next((p for p in self.points if math.dist(p, (start.x, start.y)) > MIN_SEPARATION), None)
-        if first is None:
-            self.via_times = [0.0] * len(self.points)
-            self.curve_from = 0.0
-            return Chain([], start)
-        off = wrap_angle(math.atan2(first[1] - start.y, first[0] - start.x) - start.theta)
-        prefix: list[Path] = []
-        if abs(off) > ALIGN_TOLERANCE:
-            prefix.append(turn(start, off, self.limits))
-            start = Pose2D(start.x, start.y, start.theta + off)
-        plan = plan_curve(start, self.points, self.limits)
-        if plan is None:
+        super().__init__(odometry, Chain([], start), "move_cruise_abs")
+        self.points: list[tuple[float, float]] = []
+        self.via_times: list[float] = []            # motion time from t0 of passing each point
+        self.from_rest, self.curve_from = True, 0.0
+        self.limits = limits
+        if not self._replan(0.0, [point]):
             raise ValueError("no feasible timing for the cruise path")
-        self.curve_from = sum(p.duration for p in prefix)
-        self.via_times = [self.curve_from + t for t in plan.via_times]
-        return Chain(prefix + [plan.path], self.start)
 
     def add_point(self, point: tuple[float, float], t: float) -> bool:
         """Pass `point` after the others, re-planning from motion time t (the present, or 0 when
         still queued). False when the base is already stopping at its last point, or when no
         feasible path continues from its present speed (then the caller queues a new motion)."""
-        if self.from_rest and t <= self.t0 + self.curve_from:   # not on the curve yet: plan again
-            self.points.append(point)
-            self.path = self._plan_from_rest()
-            return True
-        local = t - self.t0
-        ahead = [p for p, tp in zip(self.points, self.via_times) if tp > local + SAMPLE_DT]
-        v0, _ = self.reference_twist(t)
-        if not ahead or v0 <= 1e-4:
-            return False
-        plan = plan_curve(self.at(t), ahead + [point], self.limits, v0)
-        if plan is None:
-            return False
-        self.points = ahead + [point]
-        self.splice(t, plan.path)
-        self.from_rest, self.curve_from = False, 0.0
-        self.via_times = plan.via_times
+        return self._replan(t, [point])
+
+    def retime(self, t: float, limits: tuple[float, float, float, float]) -> None:
+        """New velocity or acceleration settings: the rest of the path re-planned from t."""
+        self.limits = limits
+        self._replan(t, [])
+
+    def move_frame(self, frame: Pose2D) -> None:
+        super().move_frame(frame)
+        self.points = [(q.x, q.y) for q in (frame.compose(Pose2D(x, y, 0.0)) for x, y in self.points)]
+
+    def _replan(self, t: float, extra: list[tuple[float, float]]) -> bool:
+        local, here = t - self.t0, self.at(t)
+        v0, w0 = self.reference_twist(t)
+        if self.from_rest and local <= self.curve_from:        # turning toward the first point
+            points = self.points + extra
+            first = next((p for p in points if math.dist(p, (here.x, here.y)) > MIN_SEPARATION), None)
+            off = 0.0 if first is None else wrap_angle(
+                math.atan2(first[1] - here.y, first[0] - here.x) - here.theta)
+            prefix: list[Path] = []
+            if abs(off) > ALIGN_TOLERANCE or abs(w0) > 0.0:
+                prefix.append(CurvePath(here, (0.0, math.copysign(1.0, off)), abs(off),
+                                        self.limits, abs(w0)))
+            plan = plan_curve(Pose2D(here.x, here.y, here.theta + off), points, self.limits)
+            if plan is None and first is not None:
+                return False
+            parts = prefix + ([plan.path] if plan is not None else [])
+            self.curve_from = sum(p.duration for p in prefix)
+            self.via_times = [self.curve_from + v for v in (plan.via_times if plan else [0.0] * len(points))]
+        else:
+            points = [p for p, tp in zip(self.points, self.via_times) if tp > local + SAMPLE_DT] + extra
+            if not points or v0 <= 1e-4:
+                return False
+            plan = plan_curve(here, points, self.limits, v0)
+            if plan is None:
+                return False
+            parts, self.from_rest, self.curve_from = [plan.path], False, 0.0
+            self.via_times = plan.via_times
+        self.points = points
+        self.splice(max(t, self.t0), Chain(parts, here))
         return True
 
 

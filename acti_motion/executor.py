@@ -75,6 +75,11 @@ class Device:
         return self.current is not None or bool(self.queue)
 
     @property
+    def stopping(self) -> bool:
+        """A stop is decelerating the current motion."""
+        return self._stop_at is not None
+
+    @property
     def queue_length(self) -> int:
         return len(self.queue)
 
@@ -265,8 +270,12 @@ class MotionExecutor:
     """Steps the world (at its own fixed time step) on a thread of its own, `real_time_factor`
     times faster than wall time (0: as fast as it can), and advances every device each step."""
 
-    def __init__(self, world: World, real_time_factor: float = 1.0) -> None:
+    def __init__(self, world: World, real_time_factor: float = 1.0,
+                 alive: Callable[[], bool] = lambda: True) -> None:
+        """`alive` tells whether the host process still runs: once it says no, the thread ends
+        and a step that failed because the host is shutting down (a closed publisher) is quiet."""
         self.world = world
+        self._alive = alive
         self.dt = world.time_step
         self.real_time_factor = real_time_factor
         self.devices: dict[str, Device] = {}
@@ -317,8 +326,13 @@ class MotionExecutor:
     def _loop(self) -> None:
         wall0 = time.monotonic()
         sim0 = self.world.time
-        while self._running.is_set():
-            self.step()
+        while self._running.is_set() and self._alive():
+            try:
+                self.step()
+            except Exception:
+                if self._alive():
+                    raise
+                return
             ahead = 0.0
             if self.real_time_factor > 0:
                 ahead = (self.world.time - sim0) / self.real_time_factor - (time.monotonic() - wall0)

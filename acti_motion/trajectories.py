@@ -235,7 +235,8 @@ class CartesianPlanner:
     # --- the elbow along the path: transported without twist, plus an even turn to the target ---
     def _elbow_plan(self, path, to_flange, start_q, psi, turn) -> "_ElbowPlan":
         kin = self.kin
-        grid = np.linspace(0.0, 1.0, 129)
+        grid = np.linspace(0.0, 1.0, 1 + min(128, max(16, math.ceil(path.length / 0.005),
+                                                      math.ceil(path.angle / 0.02))))
         us = np.array([_unit(kin.wrist_of(to_flange(path.pose(s))) - kin.shoulder) for s in grid])
         n = kin.elbow_direction(start_q)[1]
         ns = np.empty_like(us)

@@ -167,8 +167,19 @@ class VehicleCore:
         self.digital_sensor_lock = False
         self._contact_armed = True
         self._stuck_since: float | None = None
-        self.velocity = (c.default_velocity_translation, c.default_velocity_rotation)
-        self.acceleration = (c.default_accel_translation, c.default_accel_rotation)
+        try:                          # the start-up settings obey the rules of the setters
+            self.velocity = positive_pair(
+                (c.default_velocity_translation, c.default_velocity_rotation),
+                (c.velocity_limit_translation, c.velocity_limit_rotation), "default velocity",
+                ("mm/s", "degree/s"))
+            self.acceleration = positive_pair(
+                (c.default_accel_translation, c.default_accel_rotation),
+                (c.accel_limit_translation, c.accel_limit_rotation), "default acceleration",
+                ("mm/s²", "degree/s²"))
+        except Refused as r:
+            raise ValueError(f"vehicle configuration: {r.comment}") from None
+        if c.jog_timeout <= 0:
+            raise ValueError(f"vehicle configuration: jog_timeout is {c.jog_timeout} ms, it must be > 0")
         self.jog_timeout = c.jog_timeout
         self.joystick = False
         self._dt = executor.dt
@@ -186,8 +197,8 @@ class VehicleCore:
             return VehicleState.POWERED
         if self.stuck:
             return VehicleState.STUCK
-        if self.device.paused:
-            return VehicleState.PAUSED
+        if self.device.paused:        # Paused once at rest; Busy while it decelerates
+            return VehicleState.BUSY if self.device.moving and self.device.rate > 0.0 else VehicleState.PAUSED
         if self.device.busy:
             return VehicleState.BUSY
         if self._latest_warning() is not None:
@@ -307,10 +318,12 @@ class VehicleCore:
 
     @command
     def set_velocity(self, vel: Any) -> None:
-        """Within the unit's limits, > 0. Taken by every motion planned from now on."""
+        """Within the unit's limits, > 0. A moving base changes speed smoothly (at the
+        acceleration setting) to match; queued moves take it too. Jogs keep their velocities."""
         c = self.config
         self.velocity = positive_pair(vel, (c.velocity_limit_translation, c.velocity_limit_rotation),
                                       "vel", ("mm/s", "degree/s"))
+        self._retime()
 
     @command
     def set_acceleration(self, accel: Any) -> None:
@@ -323,6 +336,7 @@ class VehicleCore:
             raise VehicleRefused(AlarmCode.WRONG_STATE,
                                  f"the base is {STATE_STRINGS[s]}: set_acceleration is refused while moving")
         self.acceleration = value
+        self._retime()
 
     @command
     def set_jog_timeout(self, timeout: int) -> None:
@@ -592,6 +606,8 @@ class VehicleCore:
                                      "idle base (wait, or call stop)")
             return None
         motion_id = self.device.edit(update)
+        if motion_id is None and target == (0.0, 0.0):
+            return {"motion_id": 0}                  # standing still already: nothing to queue
         if motion_id is None:
             return self._submit(plan, label)
         self._accepted_motion()
@@ -600,6 +616,19 @@ class VehicleCore:
     def _accepted_motion(self) -> None:
         self.stuck = False
         self.alarms.clear(Kind.STUCK)
+
+    def _retime(self) -> None:
+        """Apply new settings to the running motion (from now on) and to the queued ones."""
+        limits = self._limits()
+
+        def retime(device: Device) -> None:
+            cur = device.current
+            if cur is not None and not device.stopping and hasattr(cur.motion, "retime"):
+                cur.motion.retime(device.t, limits)
+            for queued in device.queue:
+                if hasattr(queued.motion, "retime"):
+                    queued.motion.retime(0.0, limits)
+        self.device.edit(retime)
 
     def _reference_twist(self) -> tuple[float, float]:
         cur = self.device.current

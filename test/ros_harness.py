@@ -28,4 +28,5 @@ def node_fixture(module: str, *params: str):
         code = node.stop()
         assert alive, f"{module} died during the tests:\n{node.log()}"
         assert code in (0, -signal.SIGINT), f"{module} exited with {code}:\n{node.log()}"
+        assert "Traceback" not in node.log(), f"{module} logged an exception:\n{node.log()}"
     return fixture

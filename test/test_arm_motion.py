@@ -243,6 +243,17 @@ def test_stop_while_paused_flushes_and_clears_the_pause(arm, executor):  # noqa:
     assert arm.state_word() == 0x01
 
 
+def test_pause_while_stopping_is_ignored(arm, executor):  # noqa: F811
+    assert arm.move_ptp_joint_rel([20.0] * 7).ok
+    run_until(executor, lambda: executor.world.time > 0.5, 2.0)
+    assert arm.stop().ok
+    assert arm.pause().comment == "ignored: it is stopping"
+    run_until(executor, lambda: not arm.device.busy, 1.0)
+    assert arm.state_word() == 0x01
+    assert arm.move_ptp_joint_rel([1.0] * 7).ok
+    assert run_until(executor, lambda: not arm.device.busy, 2.0) > 0.2
+
+
 # --- gripper -------------------------------------------------------------------------------------------------
 def test_gripper_commands_queue_in_order_with_the_moves(arm, executor):  # noqa: F811
     assert arm.move_ptp_joint_rel([10.0] * 7).ok
@@ -317,3 +328,33 @@ def test_elbow_turns_without_moving_the_control_point(arm, executor):  # noqa: F
     got, elbow = feedback(arm)
     assert max(worst) <= 0.5 and orientation_error_deg(got, P0) <= 0.05
     assert abs(wrap(math.radians(elbow - elbow0 - 60.0))) < math.radians(0.05)
+
+
+def test_offsets_apply_to_cp_targets_and_feedback(arm, executor):  # noqa: F811
+    base = np.eye(4)                               # robot frame: 100 mm ahead, turned 90° about z
+    base[:3, :3] = pin.exp3(np.radians([0.0, 0.0, 90.0]))
+    base[:3, 3] = [0.1, 0.0, 0.0]
+    tool = np.eye(4)                               # control point 120 mm out, tilted 20° about x
+    tool[:3, :3] = pin.exp3(np.radians([20.0, 0.0, 0.0]))
+    tool[:3, 3] = [0.0, 0.0, 0.12]
+    assert arm.set_base_offset(pose_to_hg(base)).ok
+    assert arm.set_control_point_offset(pose_to_hg(tool)).ok
+    P0, elbow0 = feedback(arm)
+    flange = arm.kin.flange(executor.world.arm_positions())
+    want0 = np.linalg.inv(base) @ flange @ tool
+    assert position_error_mm(P0, want0) < 1e-6 and orientation_error_deg(P0, want0) < 1e-6
+    target = P0.copy()
+    target[:3, 3] += [-0.1, 0.2, -0.1]             # robot-frame axes
+    target[:3, :3] = pin.exp3(np.radians([0.0, 25.0, 0.0])) @ P0[:3, :3]
+    assert arm.move_linear_cartesian_abs((pose_to_hg(target), elbow0, 0)).ok
+    line, deviation = target[:3, 3] - P0[:3, 3], []
+
+    def check(P, _):
+        v = P[:3, 3] - P0[:3, 3]
+        deviation.append(np.linalg.norm(v - np.dot(v, line) / np.dot(line, line) * line) * 1000)
+    follow(arm, executor, check)
+    for _ in range(60):
+        executor.step()
+    got, _ = feedback(arm)
+    assert max(deviation) <= 0.5
+    assert position_error_mm(got, target) <= 0.1 and orientation_error_deg(got, target) <= 0.05

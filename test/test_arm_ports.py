@@ -350,3 +350,24 @@ def test_settings_refused_while_moving(arm, executor):  # noqa: F811
     r = arm.set_control_point_offset(IDENTITY)
     assert r.code == R.STATUS_ERR
     assert arm.set_base_offset(IDENTITY).ok          # the spec lists no STATUS_ERR for it
+
+
+@pytest.mark.parametrize("field, value", [
+    ("queue_size", 0), ("initial_speed_ratio", 101), ("accel_time_joint", 0.0),
+    ("max_speed_translation", NAN), ("soft_limit_cartesian", (1.0, 0.0, 0, 1, 0, 1)),
+    ("soft_limit_cartesian", (0.0, 1.0)), ("initial_joints_deg", (0.0,) * 6),
+    ("home_joints_deg", (0.0, 200.0, 0, 0, 0, 0, 0)),
+])
+def test_bad_start_settings_are_refused_at_start(executor, field, value):  # noqa: F811
+    with pytest.raises(ValueError, match=field):
+        ArmCore(executor, ArmConfig(**{field: value}))
+
+
+def test_ptp_path_that_leaves_the_cartesian_box_is_refused(arm):
+    ready(arm)
+    assert arm.set_soft_limit_cartesian((1200.0, -1000.0), (1000.0, -1000.0), (1400.0, -100.0)).ok
+    mirror = [0.0, -30.0, 0.0, 60.0, 0.0, -60.0, 0.0]      # same height, but straight up between
+    r = arm.move_ptp_joint_abs(mirror)
+    assert r.code == R.VALUE_ERR and "the path leaves the Cartesian soft limit: z" in r.comment
+    assert arm.set_soft_limit_cartesian((1200.0, -1000.0), (1000.0, -1000.0), (1500.0, -100.0)).ok
+    assert arm.move_ptp_joint_abs(mirror).ok

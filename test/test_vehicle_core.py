@@ -74,6 +74,13 @@ def test_move_circular_rel_about_a_point_on_the_axle(base, executor, centre_y, a
     assert max(abs(v) for v in speeds) <= base.velocity[0] / 1000.0 * 1.05
 
 
+def test_circular_rel_about_the_centre_of_the_axle_turns_in_place(base, executor):  # noqa: F811
+    ready(base)
+    assert base.move_circular_rel((0.0, 0.0), -45.0).ok
+    settle(executor, base)
+    assert_at(base, 0.0, 0.0, -45.0)
+
+
 def test_circular_rel_off_the_axle_is_refused(base):
     ready(base)
     r = base.move_circular_rel((100.0, 500.0), 90.0)
@@ -102,8 +109,9 @@ def test_pause_keeps_the_queue_and_accepts_new_motions_resume_runs_them(base, ex
     ready(base)
     base.move_forward(600.0)
     steps(executor, 1.0)
-    assert base.pause().ok and state(base) == VehicleState.PAUSED
+    assert base.pause().ok and state(base) == VehicleState.BUSY        # decelerating
     steps(executor, 1.0)
+    assert state(base) == VehicleState.PAUSED
     held = position(base)
     steps(executor, 1.0)
     assert position(base) == pytest.approx(held, abs=0.5)          # at rest
@@ -141,3 +149,38 @@ def test_servo_off_while_moving_stops_first(base, executor):  # noqa: F811
     settle(executor, base, 2.0)
     steps(executor, 0.5)
     assert abs(base.odometry.v) < 1e-3
+
+
+def speeds_until_done(executor, base, seconds=30.0):  # noqa: F811
+    speeds = []
+    run_until(executor, lambda: speeds.append(base.odometry.v) or not base.device.busy, seconds)
+    return speeds
+
+
+@pytest.mark.parametrize("before, after", [(300.0, 600.0), (600.0, 200.0)])
+def test_set_velocity_while_moving_changes_speed_smoothly(base, executor, before, after):  # noqa: F811
+    ready(base)
+    base.set_velocity((before, 45.0))
+    base.move_forward(3000.0)
+    assert base.move_linear_abs((1500.0, 0.0, 0.0)).ok              # queued: takes it too
+    steps(executor, 2.0)
+    assert base.odometry.v == pytest.approx(before / 1000.0, abs=0.01)
+    assert base.set_velocity((after, 45.0)).ok
+    speeds = speeds_until_done(executor, base)
+    assert speeds[int(2.0 / executor.dt)] == pytest.approx(after / 1000.0, abs=0.01)
+    accel = max(abs(b - a) for a, b in zip(speeds, speeds[1:])) / executor.dt
+    assert accel < 0.5 * 1.3                                       # the acceleration setting
+    assert min(speeds) == pytest.approx(-after / 1000.0, abs=0.01)  # the queued move
+    assert_at(base, 1500.0, 0.0, 0.0)
+
+
+def test_set_velocity_while_turning(base, executor):  # noqa: F811
+    ready(base)
+    base.move_turn(180.0)
+    steps(executor, 1.5)
+    assert math.degrees(base.odometry.w) == pytest.approx(45.0, abs=1.0)
+    base.set_velocity((300.0, 20.0))
+    steps(executor, 1.0)
+    assert math.degrees(base.odometry.w) == pytest.approx(20.0, abs=1.0)
+    settle(executor, base)
+    assert_at(base, 0.0, 0.0, 180.0)

@@ -158,3 +158,22 @@ def test_continuous_rel_queued_behind_a_move_is_retargeted_from_its_start(base, 
     assert base.move_continuous_rel((300.0, 0.0, 0.0)).values["motion_id"] == a == 2
     run_recording_speed(executor, base)
     assert_at(base, 500.0, 300.0, 90.0)
+
+
+def test_set_velocity_while_cruising(base, executor):  # noqa: F811
+    ready(base)
+    base.set_velocity((600.0, 90.0))
+    for p in POINTS:
+        base.move_cruise_abs(p)
+    trace = []
+    for _ in range(int(3.0 / executor.dt)):
+        executor.step()
+        p = base.odometry.pose
+        trace.append((1000.0 * p.x, 1000.0 * p.y, base.odometry.v, base.odometry.w))
+    assert base.set_velocity((200.0, 90.0)).ok
+    trace += record(executor, base)
+    check_passes_every_point_without_stopping(trace, POINTS)
+    later = [s[2] for s in trace[int(4.5 / executor.dt):-int(2.0 / executor.dt)]]
+    assert max(later) < 0.21                                       # slowed to the new setting
+    x, y, _ = base.get_position().values["pos"]
+    assert math.dist((x, y), POINTS[-1]) < 5.0

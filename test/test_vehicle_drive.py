@@ -81,3 +81,19 @@ def test_joystick_is_ignored_while_moves_are_queued(base):
     base.move_forward(300.0)
     assert not base.joy_input([0.0, 1.0], [])
     assert base.device.last_id == 1 and not base.alarms.active()
+
+
+def test_a_zero_jog_on_an_idle_base_queues_nothing(base):
+    ready(base)
+    r = base.move_jog(0.0, 0.0, 0.0)
+    assert r.ok and r.values["motion_id"] == 0 and state(base) == VehicleState.READY
+
+
+def test_a_zero_jog_brakes_a_running_jog(base, executor):  # noqa: F811
+    ready(base)
+    base.set_jog_timeout(5000)
+    base.move_jog(300.0, 0.0, 0.0)
+    steps(executor, 1.0)
+    assert base.move_jog(0.0, 0.0, 0.0).values["motion_id"] == 1
+    took = run_until(executor, lambda: abs(base.odometry.v) < 0.005, 2.0)
+    assert took == pytest.approx(0.3 / 0.5, abs=0.1)            # at the acceleration setting

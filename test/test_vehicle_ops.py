@@ -296,6 +296,8 @@ def test_bad_inputs_are_refused_with_a_reason_and_the_queue_intact(base, name, k
     ("move_linear_rel", dict(pos=(100.0, 0.0, 0.0))),
     ("move_circular_rel", dict(center_point=(0.0, 100.0), theta=10.0)),
     ("move_linear_abs", dict(pos=(100.0, 0.0, 0.0))),
+    ("move_continuous_rel", dict(pos=(100.0, 0.0, 0.0))), ("move_cruise_abs", dict(cruise_point=(100.0, 0.0))),
+    ("move_jog", dict(x_vel=100.0, y_vel=0.0, theta_vel=0.0)),
 ])
 @pytest.mark.parametrize("situation", ["unpowered", "powered", "locked"])
 def test_motion_is_refused_without_servo_or_while_locked(base, name, kwargs, situation):
@@ -326,3 +328,34 @@ def test_always_true_operations(base):
         assert op().ok
     assert base.set_digital_sensor_lock(True).ok and base.set_digital_sensor_lock(False).ok
     assert base.get_position().ok and base.get_battery_voltage().ok
+
+
+def test_set_power_off_while_moving_stops_and_drops_the_servo(base, executor):  # noqa: F811
+    ready(base)
+    base.move_forward(1000.0)
+    steps(executor, 1.0)
+    assert base.set_power(False).ok and state(base) == VehicleState.UNPOWERED and not base.servo
+    assert base.device.queue_length == 0
+    settle(executor, base, 2.0)
+    steps(executor, 0.3)
+    assert abs(base.odometry.v) < 1e-3
+    assert base.set_power(True).ok and state(base) == VehicleState.POWERED
+
+
+def test_pause_reports_busy_until_the_base_is_at_rest(base, executor):  # noqa: F811
+    ready(base)
+    base.set_velocity((800.0, 45.0))
+    base.move_forward(2000.0)
+    run_until(executor, lambda: base.odometry.v > 0.79, 5.0)
+    base.pause()
+    assert state(base) == VehicleState.BUSY                  # decelerating at the maximum
+    took = run_until(executor, lambda: state(base) == VehicleState.PAUSED, 2.0)
+    assert took == pytest.approx(0.8 / 1.0, abs=0.05)        # 800 mm/s at 1000 mm/s²
+    assert abs(base.odometry.v) < 0.02
+
+
+@pytest.mark.parametrize("config", [dict(default_velocity_translation=2000.0),
+                                    dict(default_accel_rotation=0.0), dict(jog_timeout=0)])
+def test_start_up_settings_outside_the_limits_are_rejected(executor, config):  # noqa: F811
+    with pytest.raises(ValueError, match="vehicle configuration"):
+        VehicleCore(executor, VehicleConfig(**config))

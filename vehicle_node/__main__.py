@@ -1,17 +1,12 @@
 """python -m vehicle_node [--ros-args ...]: the base node alone, with its own world."""
 from __future__ import annotations
 
-import sys
-
-import rclpy
-
+from acti_bringup.simulation import run_alone
 from vehicle_node.node import VehicleNode
 
 
 def main(args: list[str] | None = None) -> None:
-    rclpy.init(args=sys.argv if args is None else args)
-    node = VehicleNode()
-    node.simulation.spin(node)
+    run_alone(VehicleNode, args)
 
 
 if __name__ == "__main__":

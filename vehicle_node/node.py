@@ -1,6 +1,7 @@
 """VehicleNode: the thin ROS adapter of `acti_motion.vehicle.VehicleCore`.
 
-Services: one per IDL operation (operations.py). Topics (REP 103: m, rad):
+Services: one per IDL operation (operations.py). Action: ~/wait_motion (actions.py).
+Topics (REP 103: m, rad):
   odom (nav_msgs/Odometry)            wheel odometry, odom → base_link, 50 Hz
   ~/ground_truth (nav_msgs/Odometry)  the simulator's true pose of base_link in the world, 50 Hz
   ~/state (acti_msgs/VehicleStatus)   state code and string of table 7 and what makes it, 10 Hz
@@ -28,6 +29,7 @@ from acti_motion.replies import Reply
 from acti_motion.vehicle import VehicleConfig, VehicleCore
 from acti_motion.vehicle_alarms import AlarmType
 from acti_sim.world import World
+from vehicle_node.actions import WaitConfig, WaitMotionServer
 from vehicle_node.operations import OPERATIONS
 
 ODOM_RATE_HZ = 50.0
@@ -61,6 +63,7 @@ class VehicleNode(Node):
         self.simulation = simulation or Simulation(self)
         self.core = VehicleCore(self.simulation.executor, declare_config(self, VehicleConfig))
         serve_operations(self, self.core, OPERATIONS, write_success)
+        self.wait_motion = WaitMotionServer(self, self.core, declare_config(self, WaitConfig))
         self._odom = self.create_publisher(Odometry, "odom", 10)
         self._truth = self.create_publisher(Odometry, "~/ground_truth", 10)
         self._state = self.create_publisher(VehicleStatus, "~/state", 10)

@@ -1,0 +1,55 @@
+"""Device.edit and Device.halt (added for the base): in-place changes keep the queued end right;
+a halt discards everything at once and rests where it is told."""
+from dataclasses import dataclass
+
+from acti_motion.executor import Device
+
+
+@dataclass
+class Ramp1D:
+    """A toy motion: from `start` by `delta` over `duration` s."""
+    start: float
+    delta: float
+    duration: float
+
+    def at(self, t: float) -> float:
+        return self.start + self.delta * min(1.0, max(0.0, t / self.duration))
+
+    def apply(self, world, t: float, rate: float) -> None:
+        pass
+
+
+def test_edit_changes_a_queued_motion_and_the_queued_end_follows():
+    d = Device("toy", 4, 0.0)
+    d.submit(lambda s: Ramp1D(s, 1.0, 1.0), "a")
+    d.submit(lambda s: Ramp1D(s, 1.0, 1.0), "b")
+    assert d.queued_end == 2.0
+
+    def longer(device):
+        device.queue[-1].motion.delta = 5.0
+        return device.queue[-1].id
+    assert d.edit(longer) == 2
+    assert d.queued_end == 6.0
+    assert d.submit(lambda s: Ramp1D(s, 1.0, 1.0), "c") == 3 and d.queued_end == 7.0
+
+
+def test_edit_of_an_idle_device_moves_its_rest_point():
+    d = Device("toy", 4, 0.0)
+
+    def move(device):
+        device.hold = 3.0
+    d.edit(move)
+    assert d.queued_end == 3.0
+
+
+def test_halt_discards_the_current_and_queued_motions_at_once():
+    d = Device("toy", 4, 0.0)
+    for label in "abc":
+        d.submit(lambda s: Ramp1D(s, 1.0, 1.0), label)
+    d.tick(None, 0.5)                                       # "a" runs
+    assert d.moving and d.queue_length == 2
+    generation = d.generation
+    d.halt(0.42)
+    assert not d.busy and d.retired_id == 3 and d.discarded == 3
+    assert d.hold == d.queued_end == 0.42 and d.generation == generation + 1
+    assert d.submit(lambda s: Ramp1D(s, 1.0, 1.0), "d") == 4 and d.queued_end == 1.42
