@@ -18,6 +18,7 @@ from pathlib import Path
 import rclpy
 from acti_msgs.action import RunProgram
 from rclpy.action import ActionClient
+from rclpy.signals import SignalHandlerOptions
 
 from strolic.__main__ import load_program
 from strolic.errors import StrolicError
@@ -54,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
     except StrolicError as error:
         print(f"{args.program}: {error.report()}", file=sys.stderr)
         return 2
-    rclpy.init()
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)   # Ctrl-C: cancel, then report
     node = rclpy.create_node("run_program")
     client = ActionClient(node, RunProgram, f"{args.node.rstrip('/')}/run_program")
     try:

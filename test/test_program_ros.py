@@ -3,6 +3,7 @@ cancel mid-motion stops the arm within its deceleration time; an exception (the 
 stop from a service) is reported and the arm stops; one program at a time; the command line."""
 import math
 import os
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -156,3 +157,22 @@ def test_command_line_runs_a_file_and_shows_its_progress(arm_node):
     assert out.returncode == 0, out.stdout + out.stderr
     assert "ALMOVE" in out.stdout and "stack: I4:" in out.stdout
     assert "finished after" in out.stdout
+
+
+def test_command_line_ctrl_c_cancels_the_run(ros, arm_node):
+    ready(ros)
+    cli = subprocess.Popen([sys.executable, "-m", "acti_middle_node.run_program",
+                            str(EXAMPLES / "robot_palletising.sasm")],
+                           cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                           env=dict(os.environ))
+    try:
+        first = cli.stdout.readline()                        # a progress line: it runs
+        assert first.startswith("@"), first
+        cli.send_signal(signal.SIGINT)
+        out, _ = cli.communicate(timeout=60)
+    finally:
+        if cli.poll() is None:
+            cli.kill()
+    assert cli.returncode == 2, out
+    assert "canceled after" in out and "stopped by the operator" in out
+    assert wait_until(lambda: not moving(ros), 5.0)
