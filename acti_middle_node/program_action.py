@@ -37,6 +37,7 @@ class ProgramAction:
         self.server = ActionServer(node, RunProgram, "~/run_program", self._execute,
                                    callback_group=group, goal_callback=self._admit,
                                    cancel_callback=self._cancel)
+        node.context.on_shutdown(lambda: self._cancel(None))    # the node stops: so does the run
 
     def _admit(self, _goal: Any) -> GoalResponse:
         with self._lock:
@@ -75,11 +76,11 @@ class ProgramAction:
         self._current = run
         run.start()
         while not run.join(self.period):
-            if goal_handle.is_cancel_requested:
+            if goal_handle.is_cancel_requested or not self.node.context.ok():
                 run.cancel()
             feedback = RunProgram.Feedback()
             fill(feedback, dataclasses.asdict(run.progress()))
-            goal_handle.publish_feedback(feedback)
+            self._quietly_at_shutdown(goal_handle.publish_feedback, feedback)
         r = run.result
         error = r.error
         self.node.get_logger().info(f"program {r.status.name.lower()} after {r.instructions} "
@@ -89,13 +90,17 @@ class ProgramAction:
             exception_kind=error.kind.value if error else "",
             exception_offset=_offset(error), stack=r.stack, output=r.output,
             console=r.console, instructions=r.instructions, duration=r.duration)
-        if r.status is Status.FINISHED:
-            goal_handle.succeed()
-        elif r.status is Status.CANCELED:
-            goal_handle.canceled()
-        else:
-            goal_handle.abort()
+        end = {Status.FINISHED: goal_handle.succeed, Status.CANCELED: goal_handle.canceled}
+        self._quietly_at_shutdown(end.get(r.status, goal_handle.abort))
         return result
+
+    def _quietly_at_shutdown(self, fn, *args) -> None:
+        """Call fn; once the node shuts down (the action server is going), a failure is none."""
+        try:
+            fn(*args)
+        except Exception:
+            if self.node.context.ok():
+                raise
 
 
 def _offset(error: StrolicError | None) -> int:

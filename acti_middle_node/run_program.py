@@ -7,12 +7,13 @@ and sent as code to ~/run_program. Progress lines show the program counter (byte
 `python -m strolic dis --offsets` numbers the codes), the state and the arm's motion; at the end
 the console lines, what the program sent, the final stack and the exception report if any.
 Ctrl-C cancels the run (the program and the arm stop). Exit status: 0 the program finished,
-1 an exception stopped it, 2 it was canceled or did not load, 3 no node answered.
+1 an exception stopped it, 2 it was canceled or did not load, 3 no node answered (or it went away).
 """
 from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
 
 import rclpy
@@ -24,6 +25,7 @@ from strolic.__main__ import load_program
 from strolic.errors import StrolicError
 
 SERVER_TIMEOUT = 30.0
+SERVER_LOST = 5.0        # s without the action server: the node has gone
 
 
 def describe(feedback: RunProgram.Feedback) -> str:
@@ -47,6 +49,21 @@ def report(result: RunProgram.Result, out=sys.stdout) -> None:
           f"instructions, {result.duration:.2f} s (simulated)", file=out)
     if result.exception:
         print(result.exception, file=out)
+
+
+def wait_for(node, client: ActionClient, future) -> bool:
+    """Spin until `future` is done; False (and a message) when the node goes away meanwhile."""
+    gone_since = None
+    while not future.done():
+        rclpy.spin_until_future_complete(node, future, timeout_sec=1.0)
+        if client.server_is_ready():
+            gone_since = None
+        elif gone_since is None:
+            gone_since = time.monotonic()
+        elif time.monotonic() - gone_since > SERVER_LOST:
+            print("the node went away before the program ended", file=sys.stderr)
+            return False
+    return True
 
 
 def run(args: argparse.Namespace) -> int:
@@ -80,11 +97,13 @@ def run(args: argparse.Namespace) -> int:
             return 2
         done = handle.get_result_async()
         try:
-            rclpy.spin_until_future_complete(node, done)
+            if not wait_for(node, client, done):
+                return 3
         except KeyboardInterrupt:
             print("canceling ...", file=sys.stderr)
-            rclpy.spin_until_future_complete(node, handle.cancel_goal_async())
-            rclpy.spin_until_future_complete(node, done)
+            rclpy.spin_until_future_complete(node, handle.cancel_goal_async(), timeout_sec=10.0)
+            if not wait_for(node, client, done):
+                return 3
         result = done.result().result
         report(result)
         return {RunProgram.Result.FINISHED: 0, RunProgram.Result.EXCEPTION: 1}.get(result.status, 2)

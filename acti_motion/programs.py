@@ -99,8 +99,17 @@ class ProgramRun:
 
     def start(self) -> None:
         """Run on a thread of its own (`join`, `result`)."""
-        self._thread = threading.Thread(target=self.run, name="strolic-program", daemon=True)
+        self._thread = threading.Thread(target=self._run_guarded, name="strolic-program",
+                                        daemon=True)
         self._thread.start()
+
+    def _run_guarded(self) -> None:
+        try:
+            self.run()
+        except Exception as e:  # the world went away (shutdown) or a bug: no traceback, a result
+            self.result = ProgramResult(
+                Status.EXCEPTION, StrolicError(K.CONTROLLER_ERROR, f"{type(e).__name__}: {e}"),
+                console=list(self.host.lines), instructions=self.vm.executed)
 
     def join(self, timeout: float | None = None) -> bool:
         if self._thread is not None:
