@@ -336,7 +336,8 @@ class RobotHost(Host):
 
     def _ramp(self, kind: str) -> float:
         """Accel/decel time (s) of a move: the longer of the ACCEL and DECEL settings (the
-        profiles are symmetric), the port's accel time while neither is set."""
+        profiles are symmetric; one that is not set follows the other), the port's accel time
+        while neither is set."""
         arm = self.arm
         joint = kind == "joint"
         minimum = arm.min_accel_time_joint if joint else arm.min_accel_time_cartesian
@@ -347,7 +348,7 @@ class RobotHost(Host):
                 return default
             how, value = setting
             return minimum * 100.0 / value if how == "percent" else value
-        return max(of(self.accel), of(self.decel), minimum)
+        return max(of(self.accel or self.decel), of(self.decel or self.accel), minimum)
 
     def _cartesian_ratio(self) -> float:
         return 100.0 * self.speed / self.arm.max_speed_cartesian[0]

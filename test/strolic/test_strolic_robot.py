@@ -240,3 +240,27 @@ def test_done_sees_the_abnormal_end_and_the_program_still_stops(arm, executor): 
                  hook=hook)
     assert seen and result.status is Status.EXCEPTION and result.error.kind is K.ROBOT_ERROR
     assert result.stack[-1] == "I2:-1"                        # $DONE gave the abnormal end
+
+
+TIMED = "CLOCK {move} DROP -1 $WAIT DROP CLOCK EXCH SUB"
+J7_60 = ("Ar[R8 0 0 0 0 0 0 60] IDRIVE", 60 / 135.0)      # J7: 60° at most 135°/s
+DOWN_100 = ("HERE Vec(0 0 -100) DEV ALMOVE", 100 / 500.0)  # 100 mm at most 500 mm/s
+
+
+@pytest.mark.parametrize("settings, move, ratio, ramp", [
+    (["50 JSPEED"], J7_60, 0.5, 0.3), (["25 JSPEED"], J7_60, 0.25, 0.3),
+    (["50 JSPEED", "1.0 ACCEL2"], J7_60, 0.5, 1.0),
+    (["50 JSPEED", "0.8 DECEL2"], J7_60, 0.5, 0.8),
+    (["50 JSPEED", "0.2 ACCEL2", "0.5 DECEL2"], J7_60, 0.5, 0.5),
+    (["50 JSPEED", "50 ACCEL1"], J7_60, 0.5, 0.2),
+    (["50 JSPEED", "100 ACCEL1", "25 DECEL1"], J7_60, 0.5, 0.4),
+    (["200 SPEED"], DOWN_100, 0.4, 0.3), (["50 SPEED"], DOWN_100, 0.1, 0.3),
+    (["200 SPEED", "0.6 ACCEL2"], DOWN_100, 0.4, 0.6)])
+def test_speed_and_acceleration_settings_time_the_moves(arm, executor, settings, move, ratio,  # noqa: F811
+                                                        ramp):
+    """A trapezoid: max(cruise, ramp) + ramp, the cruise at the set fraction of the maximum."""
+    program = " ".join(f"{setting} DROP" for setting in settings)
+    result = run(arm, executor, f"{program} {TIMED.format(move=move[0])}")
+    assert result.status is Status.FINISHED, result.report
+    seconds = max(move[1] / ratio, ramp) + ramp
+    assert int(result.stack[-1].split(":")[-1]) / 1000.0 == pytest.approx(seconds, abs=0.02)
