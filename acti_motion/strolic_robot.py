@@ -633,7 +633,7 @@ class RobotHost(Host):
             targets = self._targets(args[0])
             if relative:
                 _, start = self._start()
-                targets = [Target(compose_relative(start.pose, t.pose), t.configuration,
+                targets = [Target(compose_relative(start.pose, t.pose), start.configuration,
                                   start.elbow + t.elbow) for t in targets]
             for target in targets:
                 (self._ptp_to if joint else self._line_to)(target, name)
@@ -660,7 +660,7 @@ class RobotHost(Host):
         def run(args: list) -> None:
             _, start = self._start()
             for t in self._targets(args[0]):
-                self._line_to(Target(start.pose @ t.pose, t.configuration,
+                self._line_to(Target(start.pose @ t.pose, start.configuration,
                                      start.elbow + t.elbow), "HMOVE")
         return self._move(vm, proc, "HMOVE", 1, lambda a: self._count_of(a[0]), run,
                           self._cartesian_ratio(), "SPEED")
@@ -813,7 +813,10 @@ class RobotHost(Host):
                 raise Flag(FLAG_INVALID, f"opening {opening:g} mm is outside "
                                          f"[0, {self.max_opening:g}] mm")
             self._gripper(opening, "GRASP")
-        if count < 0 or count + 1 > len(proc.stack):
+        if count < 0:
+            proc.pop()
+            return self._flag(proc, "GRASP", Flag(FLAG_INVALID, f"parameter count {count}"))
+        if count + 1 > len(proc.stack):
             raise fail(K.STACK_UNDERFLOW, f"{count} parameters wanted")
         return self._move(vm, proc, "GRASP", count + 1, lambda a: 1, run, 1.0, "")
 

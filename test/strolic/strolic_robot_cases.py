@@ -23,6 +23,7 @@ OK, INVALID, RANGE, CONFIGURATION, NOT_READY, NO_HAND = (f"I2:{n}" for n in rang
 WORK = (0.0, 45.0, 0.0, -90.0, 0.0, 45.0, 0.0)   # the control point at (100, 0, 1231.69) mm
 FLIPPABLE = "Ar[R8 0 45 0 -90 20 45 20] ADRIVE DROP -1 $WAIT DROP "   # a wrist that can flip within limits
 DOWN = "HERE Vec(0 0 -50) DEV"                         # 50 mm below where the arm is
+READY = "Ar[R8 0 40 0 90 0 50 0] ADRIVE DROP -1 $WAIT DROP "   # tool down, configuration 2
 SOFT_LIMIT = "Ar[R8 0 45 0 -90 0 45 179] ADRIVE"        # J7 past its limit (175°)
 
 
@@ -116,7 +117,10 @@ CASES: dict[str, list[tuple]] = {
     "ILMOVE": [("Trn(20 0 -30 1 0 0 0 1 0 0 0 1) PNT DUP 2 #Pm(120) CONSA ILMOVE -1 $WAIT "
                 "HERE LOC", flags_then([OK, OK], position_near(START + [20, 0, -30]),
                                        "each pose relative to the start of the command")),
-               ("Trn(0 0 -3000 1 0 0 0 1 0 0 0 1) PNT ILMOVE", [RANGE])],
+               ("Trn(0 0 -3000 1 0 0 0 1 0 0 0 1) PNT ILMOVE", [RANGE]),
+               (READY + "Trn(0 0 -30 1 0 0 0 1 0 0 0 1) PNT ILMOVE -1 $WAIT HERE DESTP",
+                Check("a relative move keeps the arm's configuration (2)",
+                      lambda s, arm: s[:2] == [OK, OK] and s[-3] == "I2:2"))],
     "HMOVE": [("Trn(0 0 30 1 0 0 0 1 0 0 0 1) PNT HMOVE -1 $WAIT HERE LOC",
                flags_then([OK, OK], position_near(START + [0, 0, 30]), "30 mm along the tool z")),
               ("Trn(0 0 0 1 0 0 0 -1 0 0 0 -1) 1 2 HANDDEF DROP 2 HANDCHG DROP "
@@ -169,7 +173,7 @@ CASES: dict[str, list[tuple]] = {
     "GRASP": [("20 1 GRASP -1 $WAIT", Check("opening 20 mm", lambda s, arm: s == [OK, OK] and abs(
                   arm.get_feedback_pos_joint().values["pos"][7] - 20.0) < 1.0)),
               ("200 1 GRASP", [INVALID]), ("1 2 2 GRASP", [INVALID]),
-              ("0 GRASP", [INVALID]), ("20 1 GRASP", [NOT_READY], {"servo": False}),
+              ("0 GRASP", [INVALID]), ("-2 GRASP", [INVALID]), ("20 1 GRASP", [NOT_READY], {"servo": False}),
               ("1 5 GRASP", UNDER)],
     "HANDDEF": [("Trn(0 0 100 1 0 0 0 1 0 0 0 1) 60 10 3 2 HANDDEF 2 HANDREF",
                  [OK, "Trn(0.0 0.0 100.0 1.0 0.0 0.0 0.0 1.0 0.0 0.0 0.0 1.0)", "60", "10",
