@@ -11,7 +11,7 @@ from typing import Any, Callable
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SERVICE_TIMEOUT = 30.0
-CALL_TIMEOUT = 10.0
+CALL_TIMEOUT = 30.0
 
 
 class NodeProcess:
@@ -69,6 +69,15 @@ class RosClient:
         if not future.done():
             raise TimeoutError(f"{name} did not answer in {CALL_TIMEOUT} s")
         return future.result()
+
+    def spin_until(self, predicate: Callable[[], bool], timeout: float) -> bool:
+        """Serve this client's subscriptions and callbacks until predicate() holds."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if predicate():
+                return True
+            self.executor.spin_once(timeout_sec=0.02)
+        return predicate()
 
     def close(self) -> None:
         self.executor.shutdown()

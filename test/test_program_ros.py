@@ -41,11 +41,6 @@ def states(ros, arm_node):
     return seen
 
 
-def spin_until(ros, predicate, timeout):
-    return wait_until(lambda: (ros.executor.spin_once(timeout_sec=0.01), predicate())[1],
-                      timeout, period=0.0)
-
-
 def ready(ros):
     call(ros, "clear_alarms", srv.ClearAlarms)
     assert call(ros, "servo_on", srv.ServoON).return_id.id == 0
@@ -92,7 +87,7 @@ def test_cancel_mid_motion_stops_the_arm_within_its_deceleration_time(ros, progr
     feedback = []
     handle = programs.send(lambda f: feedback.append(f.feedback),
                            text="40 JSPEED DROP Ar[R8 0 0 0 0 0 0 -150] IDRIVE DROP -1 $WAIT")
-    assert spin_until(ros, lambda: any(f.motion_label == "IDRIVE" and f.progress > 0.2
+    assert ros.spin_until(lambda: any(f.motion_label == "IDRIVE" and f.progress > 0.2
                                        for f in feedback) and states and states[-1][1] & 0x02,
                       30.0)
     sent_at = states[-1][0]
@@ -100,7 +95,7 @@ def test_cancel_mid_motion_stops_the_arm_within_its_deceleration_time(ros, progr
     status, result = programs.result(handle)
     assert status == GoalStatus.STATUS_CANCELED and result.status == R.CANCELED
     assert result.exception_kind == "stopped by the operator" and result.stack == ["-1"]
-    assert spin_until(ros, lambda: any(t > sent_at and not word & 0x02 for t, word in states),
+    assert ros.spin_until(lambda: any(t > sent_at and not word & 0x02 for t, word in states),
                       10.0)
     rest_at = next(t for t, word in states if t > sent_at and not word & 0x02)
     # the state topic's period (0.2 s simulated) on either side of the deceleration

@@ -99,16 +99,6 @@ def test_moves_over_dds(ros, vehicle):
     assert vehicle.alive()
 
 
-def spin_until(ros, predicate, timeout):
-    """Spin the client (subscriptions) until predicate() holds."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if predicate():
-            return True
-        ros.executor.spin_once(timeout_sec=0.05)
-    return predicate()
-
-
 def test_topics_state_diagnostics_odom_and_cmd_vel(ros, vehicle):
     got = {"state": [], "diag": [], "odom": [], "truth": []}
     subs = [ros.node.create_subscription(VehicleStatus, BASE + "state", got["state"].append, 10),
@@ -118,7 +108,8 @@ def test_topics_state_diagnostics_odom_and_cmd_vel(ros, vehicle):
     cmd = ros.node.create_publisher(Twist, "/cmd_vel", 10)
     try:
         assert call(ros, "set_power", on_off=True).success and call(ros, "set_servo", on_off=True).success
-        assert spin_until(ros, lambda: all(got.values()), 10.0)
+        # a status published before set_servo may still be in flight: wait for Ready
+        assert ros.spin_until(lambda: all(got.values()) and got["state"][-1].state == 0x010, 10.0)
         status = got["state"][-1]
         assert (status.state, status.msg, status.power, status.servo) == (0x010, "Ready", True, True)
         names = [s.name for s in got["diag"][-1].status]
@@ -132,7 +123,7 @@ def test_topics_state_diagnostics_odom_and_cmd_vel(ros, vehicle):
             cmd.publish(twist)
             ros.executor.spin_once(timeout_sec=0.05)
         seen = len(got["state"])
-        assert spin_until(ros, lambda: got["state"][-1].state == 0x010, 5.0)   # stopped by itself
+        assert ros.spin_until(lambda: got["state"][-1].state == 0x010, 5.0)   # stopped by itself
         assert 0x011 in [m.state for m in got["state"][seen - 20:]]            # after Busy
         odom = got["odom"][-1]
         assert odom.header.frame_id == "odom" and odom.child_frame_id == "base_link"
@@ -155,16 +146,16 @@ def test_joystick_over_the_joy_topic(ros, vehicle):
     joy = ros.node.create_publisher(Joy, "/joy", 10)
     try:
         assert call(ros, "set_power", on_off=True).success and call(ros, "set_servo", on_off=True).success
-        assert spin_until(ros, lambda: got and got[-1].state == 0x010, 10.0)
+        assert ros.spin_until(lambda: got and got[-1].state == 0x010, 10.0)
         assert call(ros, "set_joystick", on_off=True).success
-        assert spin_until(ros, lambda: got[-1].joystick, 2.0)
+        assert ros.spin_until(lambda: got[-1].joystick, 2.0)
         deadline = time.monotonic() + 0.75
         while time.monotonic() < deadline:                        # 20 Hz, like joy_node's autorepeat
             joy.publish(Joy(axes=[0.0, 0.5], buttons=[]))
             ros.executor.spin_once(timeout_sec=0.05)
-        assert spin_until(ros, lambda: any(m.state == 0x011 for m in got[-20:]), 2.0)
+        assert ros.spin_until(lambda: any(m.state == 0x011 for m in got[-20:]), 2.0)
         assert call(ros, "set_joystick", on_off=False).success
-        assert spin_until(ros, lambda: got[-1].state == 0x010 and not got[-1].joystick, 5.0)
+        assert ros.spin_until(lambda: got[-1].state == 0x010 and not got[-1].joystick, 5.0)
     finally:
         ros.node.destroy_subscription(sub)
         ros.node.destroy_publisher(joy)
