@@ -219,7 +219,7 @@ class ArmCore:
                           f"left [{lim[0]:g}, {lim[1]:g}] mm")
         with self._alarm_lock:
             self._alarms.append(alarm)
-        self._stop_motion(fastest=True)
+        self.stop_motion(fastest=True)
 
     # === common port ============================================================================
     @returns(R.STATUS_ERR)
@@ -229,7 +229,7 @@ class ArmCore:
     @returns()
     def servo_off(self) -> None:
         """All axes off; a moving arm stops first (the brakes then hold it where it stopped)."""
-        self._stop_motion()
+        self.stop_motion()
         self.servo = False
 
     @returns(*GETTER)
@@ -401,7 +401,7 @@ class ArmCore:
             why = "the arm is not moving" if self.device.current is None else "it is stopping"
         if why is not None:
             return _ignored(why)
-        if not self.device.pause(self._current_ramp()):
+        if not self.device.pause(self.current_ramp()):
             return _ignored("already paused")
         return None
 
@@ -409,7 +409,7 @@ class ArmCore:
     def resume(self) -> Reply | None:
         if not self.device.paused:
             return _ignored("the arm is not paused")
-        if not self.device.resume(self._current_ramp()):
+        if not self.device.resume(self.current_ramp()):
             return _ignored("a stop is in progress")
         return None
 
@@ -418,7 +418,7 @@ class ArmCore:
         why = self._control_ignored()
         if why is not None:
             return _ignored(why)
-        self._stop_motion()
+        self.stop_motion()
         return None
 
     # === middle-level port: moves =================================================================
@@ -426,19 +426,19 @@ class ArmCore:
     def move_ptp_joint_abs(self, joint_points: list[float]) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
         goal = np.radians(finite_vector(joint_points, self.axis_count, "joint_points"))
-        return self._queue_joint_move(lambda start: goal, "move_ptp_joint_abs")
+        return self.queue_joint_move(lambda start: goal, "move_ptp_joint_abs")
 
     @returns(*MOVE)
     def move_ptp_joint_rel(self, joint_points: list[float]) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
         delta = np.radians(finite_vector(joint_points, self.axis_count, "joint_points"))
-        return self._queue_joint_move(lambda start: start.joints + delta, "move_ptp_joint_rel")
+        return self.queue_joint_move(lambda start: start.joints + delta, "move_ptp_joint_rel")
 
     @returns(*MOVE)
     def go_home(self) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
         goal = np.radians(self.home)
-        return self._queue_joint_move(lambda start: goal, "go_home")
+        return self.queue_joint_move(lambda start: goal, "go_home")
 
     @returns(*MOVE)
     def move_ptp_cartesian_abs(self, car_point: tuple) -> dict:
@@ -457,14 +457,14 @@ class ArmCore:
     def move_linear_cartesian_abs(self, car_point: tuple) -> dict:
         self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
         target, psi = self._car_point(car_point, "car_point")
-        return self._queue_cartesian(lambda P0: LinePath(P0, target), "move_linear_cartesian_abs",
+        return self.queue_cartesian(lambda P0: LinePath(P0, target), "move_linear_cartesian_abs",
                                      psi=psi)
 
     @returns(*MOVE)
     def move_linear_cartesian_rel(self, car_point: tuple) -> dict:
         self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
         delta, turn = self._car_point(car_point, "car_point")
-        return self._queue_cartesian(lambda P0: LinePath(P0, compose_relative(P0, delta)),
+        return self.queue_cartesian(lambda P0: LinePath(P0, compose_relative(P0, delta)),
                                      "move_linear_cartesian_rel", turn=turn)
 
     @returns(*MOVE)
@@ -474,7 +474,7 @@ class ArmCore:
         self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
         via, _ = self._car_point(car_point_r, "car_point_r")
         target, psi = self._car_point(car_point_t, "car_point_t")
-        return self._queue_cartesian(lambda P0: ArcPath(P0, via[:3, 3], target),
+        return self.queue_cartesian(lambda P0: ArcPath(P0, via[:3, 3], target),
                                      "move_circular_cartesian_abs", psi=psi)
 
     @returns(*MOVE)
@@ -482,25 +482,25 @@ class ArmCore:
         self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
         via, _ = self._car_point(car_point_r, "car_point_r")
         delta, turn = self._car_point(car_point_t, "car_point_t")
-        return self._queue_cartesian(
+        return self.queue_cartesian(
             lambda P0: ArcPath(P0, P0[:3, 3] + via[:3, 3], compose_relative(P0, delta)),
             "move_circular_cartesian_rel", turn=turn)
 
     # --- gripper -----------------------------------------------------------------------------------
     @returns(R.STATUS_ERR, R.VALUE_ERR, R.FULL_MOTION_QUEUE_ERR, R.NOT_SV_ON_ERR)
     def open_gripper(self) -> dict:
-        return self._queue_gripper(100, "open_gripper")
+        return self.queue_gripper(100, "open_gripper")
 
     @returns(R.STATUS_ERR, R.FULL_MOTION_QUEUE_ERR, R.NOT_SV_ON_ERR)
     def close_gripper(self) -> dict:
-        return self._queue_gripper(0, "close_gripper")
+        return self.queue_gripper(0, "close_gripper")
 
     @returns(R.STATUS_ERR, R.VALUE_ERR, R.NOT_SV_ON_ERR)
     def move_gripper(self, angle_ratio: int) -> dict:
         """The spec lists no FULL_MOTION_QUEUE_ERR here: a full queue is STATUS_ERR."""
         ratio = ratio_percent(angle_ratio, "angle_ratio")
         try:
-            return self._queue_gripper(ratio, "move_gripper")
+            return self.queue_gripper(ratio, "move_gripper")
         except Refused as r:
             if r.code == R.FULL_MOTION_QUEUE_ERR:
                 raise Refused(R.STATUS_ERR, r.comment) from None
@@ -632,7 +632,7 @@ class ArmCore:
                               f"{qs_deg[k, j]:.3f}°, limit [{lim[j, 0]:g}, {lim[j, 1]:g}]°")
 
     # === queueing ======================================================================================
-    def _queue_joint_move(self, goal_of: Callable[[ArmSetpoint], np.ndarray], label: str,
+    def queue_joint_move(self, goal_of: Callable[[ArmSetpoint], np.ndarray], label: str,
                           speed_ratio: float | None = None, ramp: float | None = None) -> dict:
         """A PTP move to goal_of(start) (rad): synchronized trapezoid at the joint speed ratio
         and accel time (or the given ones: STROLIC programs keep their own)."""
@@ -691,9 +691,9 @@ class ArmCore:
                 return kin.solve(flange, start.joints, elbow_dir=elbow, lower=lo, upper=hi)
             except Unreachable as e:
                 raise value_error(f"{label}: {e}") from None
-        return self._queue_joint_move(goal_of, label)
+        return self.queue_joint_move(goal_of, label)
 
-    def _queue_cartesian(self, path_of: Callable[[np.ndarray], LinePath], label: str, *,
+    def queue_cartesian(self, path_of: Callable[[np.ndarray], LinePath], label: str, *,
                          psi: float | None = None, turn: float = 0.0,
                          speed_ratio: float | None = None, ramp: float | None = None) -> dict:
         """A CP move along path_of(start pose); the elbow ends at arm angle `psi`, or (Rel) is
@@ -729,7 +729,7 @@ class ArmCore:
                              "cartesian")
         return self._submit(plan, label)
 
-    def _queue_gripper(self, ratio: int, label: str) -> dict:
+    def queue_gripper(self, ratio: int, label: str) -> dict:
         self._check_can_move()
         finger = self.finger_max * ratio / 100.0
         speed = self.config.gripper_speed / 2000.0      # one finger, m/s
@@ -748,16 +748,16 @@ class ArmCore:
                           f"the motion queue is full ({self.device.capacity} motions): wait or stop")
         return {"motion_id": motion_id}
 
-    def _current_ramp(self) -> float:
+    def current_ramp(self) -> float:
         cur = self.device.current
         return cur.motion.ramp if cur is not None else self.accel_time_joint
 
-    def _stop_motion(self, fastest: bool = False) -> None:
+    def stop_motion(self, fastest: bool = False) -> None:
         cur = self.device.current
         if fastest:
             ramp = (self.min_accel_time_cartesian
                     if cur is not None and cur.motion.kind == "cartesian"
                     else self.min_accel_time_joint)
         else:
-            ramp = self._current_ramp()
+            ramp = self.current_ramp()
         self.device.stop(ramp)

@@ -231,7 +231,7 @@ class RobotHost(Host):
     def stop(self, error) -> None:
         """The program stopped on an exception: the arm decelerates and its queue is discarded."""
         self.state = "stopping"
-        self.arm._stop_motion()
+        self.arm.stop_motion()
 
     # digital I/O: RobotIO, and the status port
     def io_port_bits(self, port: int, output: bool) -> int | None:
@@ -423,13 +423,13 @@ class RobotHost(Host):
             raise refused_flag(r) from None
 
     def _joint_move(self, goal_of: Callable[[ArmSetpoint], np.ndarray], label: str) -> None:
-        self._submit(lambda: self.arm._queue_joint_move(goal_of, label, self.jspeed,
+        self._submit(lambda: self.arm.queue_joint_move(goal_of, label, self.jspeed,
                                                         self._ramp("joint")))
 
     def _cartesian_move(self, path_of: Callable[[np.ndarray], LinePath], label: str,
                         psi: float | None) -> None:
         tool = self.tool
-        self._submit(lambda: self.arm._queue_cartesian(
+        self._submit(lambda: self.arm.queue_cartesian(
             lambda P0: InHand(path_of(P0 @ tool), tool), label, psi=psi,
             speed_ratio=self._cartesian_ratio(), ramp=self._ramp("cartesian")))
 
@@ -466,7 +466,7 @@ class RobotHost(Host):
 
     def _gripper(self, opening_mm: float, label: str) -> None:
         ratio = 100.0 * opening_mm / self.max_opening
-        self._submit(lambda: self.arm._queue_gripper(ratio, label))
+        self._submit(lambda: self.arm.queue_gripper(ratio, label))
 
     def _move(self, vm, proc, name: str, nargs: int, count: Callable[[list], int],
               run: Callable[[list], None], ratio: float, setting: str):
@@ -597,7 +597,7 @@ class RobotHost(Host):
         message = pop_of(proc, Str, "a message (St)").data.decode("utf-8", "replace")
         self.console(f"PAUSE: {message}")
         arm = self.arm
-        arm.device.pause(arm._current_ramp())
+        arm.device.pause(arm.current_ramp())
         self.state, self.message = "paused", message
         started = self.now()
         try:
