@@ -41,10 +41,8 @@ class ArmNode(Node):
         group = ReentrantCallbackGroup()
         actions = declare_config(self, ActionConfig)
         topics = declare_config(self, TopicConfig)
-        if actions.feedback_rate_hz <= 0 or topics.state_rate_hz <= 0 \
-                or actions.max_action_goals < 1:
-            raise ValueError("feedback_rate_hz and state_rate_hz must be > 0, "
-                             "max_action_goals >= 1")
+        if actions.feedback_rate_hz <= 0 or topics.state_rate_hz <= 0:
+            raise ValueError("feedback_rate_hz and state_rate_hz must be > 0")
         self.actions = MotionActions(self, self.core, group, actions)
         self.programs = ProgramAction(self, self.core, group, actions.feedback_rate_hz,
                                       declare_config(self, ProgramDefaults))

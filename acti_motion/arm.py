@@ -540,10 +540,7 @@ class ArmCore:
 
     def motion_status(self) -> tuple[int, str, float, int]:
         """(current motion id or 0, its label, its completed fraction, queued motions)."""
-        cur = self.device.current
-        motion_id, fraction = self.device.progress()
-        label = cur.label if cur is not None and cur.id == motion_id else ""
-        return motion_id, label, fraction, self.device.queue_length
+        return self.device.status()
 
     # === checks ======================================================================================
     def _check_can_move(self, ratio: int | None = None, setter: str = "") -> None:

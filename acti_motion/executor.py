@@ -202,13 +202,13 @@ class Device:
         with self.lock:
             return any(lo <= motion_id <= hi for lo, hi in self._discarded_ids)
 
-    def progress(self) -> tuple[int, float]:
-        """(current motion id or 0, its completed fraction)."""
+    def status(self) -> tuple[int, str, float, int]:
+        """(current motion id or 0, its label, its completed fraction, motions queued behind)."""
         cur = self.current
         if cur is None:
-            return 0, 0.0
+            return 0, "", 0.0, len(self.queue)
         d = cur.motion.duration
-        return cur.id, 1.0 if d <= 0 else min(1.0, self.t / d)
+        return cur.id, cur.label, 1.0 if d <= 0 else min(1.0, self.t / d), len(self.queue)
 
     # --- called by the simulation thread -----------------------------------------------------
     def tick(self, world: World, dt: float) -> None:

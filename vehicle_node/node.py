@@ -96,7 +96,7 @@ class VehicleNode(Node):
     def _publish_state(self, world: World) -> None:
         core = self.core
         s = core.state()
-        motion_id, _ = core.device.progress()
+        motion_id = core.device.status()[0]
         self._state.publish(VehicleStatus(
             stamp=self.simulation.now(), state=int(s), msg=core.state_string(s), power=core.power,
             servo=core.servo, joystick=core.joystick, digital_sensor_lock=core.digital_sensor_lock,
