@@ -107,7 +107,7 @@ class Device:
                         return None
                     self.last_id += 1
                     self.queue.append(QueuedMotion(self.last_id, motion, label))
-                    self.queued_end = motion.at(motion.duration)
+                    self.queued_end = self._end_of_queue()
                     self.changed.notify_all()
                     return self.last_id
 
@@ -136,24 +136,18 @@ class Device:
         rest point is known now and becomes the start of whatever is queued next.
         """
         with self.lock:
-            self.generation += 1
-            self._retire_queue()
-            self.paused = False
+            self._discard_pending()
             cur = self.current
             if cur is None:
                 self.rate = self._rate_target = 1.0
-                self.queued_end = self.hold
-                return
-            if self._stop_at is None:
-                # a move cut short to hand over to the next (a blend) stops along its whole path
-                cur.motion = getattr(cur.motion, "unblended", cur.motion)
-                self._stop_at = min(cur.motion.duration, self.t + self.rate * self.rate * ramp / 2)
-            self._set_rate(0.0, ramp)
-            self.queued_end = cur.motion.at(self._stop_at)
-
-    @property
-    def stopping(self) -> bool:
-        return self._stop_at is not None
+            else:
+                if self._stop_at is None:
+                    # a move cut short to hand over to the next (a blend) stops along its whole path
+                    cur.motion = getattr(cur.motion, "unblended", cur.motion)
+                    self._stop_at = min(cur.motion.duration,
+                                        self.t + self.rate * self.rate * ramp / 2)
+                self._set_rate(0.0, ramp)
+            self.queued_end = self._end_of_queue()
 
     def edit(self, fn: Callable[["Device"], Any]) -> Any:
         """Run fn(device) under the lock and return its result: a core changes its motions in place
@@ -161,13 +155,7 @@ class Device:
         without racing the simulation; the queued end then follows the last motion."""
         with self.lock:
             out = fn(self)
-            last = self.queue[-1] if self.queue else self.current
-            if last is None:
-                self.queued_end = self.hold
-            elif last is self.current and self._stop_at is not None:
-                self.queued_end = last.motion.at(self._stop_at)
-            else:
-                self.queued_end = last.motion.at(last.motion.duration)
+            self.queued_end = self._end_of_queue()
             self.changed.notify_all()
             return out
 
@@ -175,12 +163,10 @@ class Device:
         """Discard the current motion and the queue at once and rest at `rest` (where the device
         is, as measured): for a device that cannot follow its plan (blocked, a contact)."""
         with self.lock:
-            self.generation += 1
-            self._retire_queue()
+            self._discard_pending()
             if self.current is not None:
                 self._finish(discarded=True)
             self._stop_at = None
-            self.paused = False
             self.rate = self._rate_target = 1.0
             self.hold = self.queued_end = rest
             self.changed.notify_all()
@@ -253,6 +239,22 @@ class Device:
             self.completed += 1
         self.current = None
         self.changed.notify_all()
+
+    def _end_of_queue(self) -> Any:
+        """Where the device rests once everything queued now is over (a stop's rest point when
+        the current motion is stopping): the start of the next motion submitted."""
+        last = self.queue[-1] if self.queue else self.current
+        if last is None:
+            return self.hold
+        if last is self.current and self._stop_at is not None:
+            return last.motion.at(self._stop_at)
+        return last.motion.at(last.motion.duration)
+
+    def _discard_pending(self) -> None:
+        """Drop the queue and a pause; motions planned meanwhile plan again (new generation)."""
+        self.generation += 1
+        self._retire_queue()
+        self.paused = False
 
     def _retire_queue(self) -> None:
         if self.queue:
