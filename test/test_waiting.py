@@ -79,3 +79,21 @@ def test_completed_motion():
     threading.Timer(0.05, lambda: [d.tick(None, 0.6) for _ in range(3)]).start()
     out = wait(d, Goal(1, timeout=5.0))
     assert out.end == "succeed" and out.completed and out.message == ""
+
+
+def test_goal_slots_reject_beyond_the_limit_and_free_a_slot_however_a_goal_ends(ros):
+    import pytest
+    from rclpy.action import GoalResponse
+
+    from acti_bringup.waiting import GoalSlots
+    with pytest.raises(ValueError, match="max_goals must be >= 1"):
+        GoalSlots(ros.node, 0, "max_goals")
+    slots = GoalSlots(ros.node, 1, "max_goals")
+    assert slots.admit(None) == GoalResponse.ACCEPT
+    assert slots.admit(None) == GoalResponse.REJECT
+
+    def failing(_handle):
+        raise RuntimeError("goal failed")
+    with pytest.raises(RuntimeError):
+        slots.holding(failing)(None)
+    assert slots.admit(None) == GoalResponse.ACCEPT
