@@ -16,7 +16,7 @@ from rclpy.node import Node
 
 from acti_bringup.conversions import fill, to_core
 from acti_bringup.waiting import GoalSlots, wait_for_motion
-from acti_motion.arm import ArmCore
+from acti_motion.arm.core import ArmCore
 from acti_motion.replies import Reply, ReturnCode
 
 # Move.Goal.kind → the core operation and the goal fields it takes (core name ← goal field).

@@ -1,4 +1,4 @@
-"""ArmNode: the thin ROS adapter of `acti_motion.arm.ArmCore`: the operation table's services,
+"""ArmNode: the thin ROS adapter of `acti_motion.arm.core.ArmCore`: the operation table's services,
 the ~/wait_motion, ~/move and ~/run_program (STROLIC) actions, and the ~/state topic."""
 from __future__ import annotations
 
@@ -16,9 +16,9 @@ from acti_bringup.simulation import Simulation
 from acti_middle_node.actions import ActionConfig, MotionActions
 from acti_middle_node.operations import OPERATIONS
 from acti_middle_node.program_action import ProgramAction
-from acti_motion.arm import ArmConfig, ArmCore
+from acti_motion.arm.core import ArmConfig, ArmCore
 from acti_motion.replies import Reply
-from acti_motion.strolic_robot import ProgramDefaults
+from acti_motion.programs.robot import ProgramDefaults
 
 
 @dataclass

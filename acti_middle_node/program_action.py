@@ -1,7 +1,7 @@
 """~/run_program (acti_msgs/action/RunProgram): a STROLIC program run on the arm, with its
 progress as feedback; canceling stops the program and the arm.
 
-The program runs on a thread of its own (`acti_motion.programs.ProgramRun`), never on the
+The program runs on a thread of its own (`acti_motion.programs.run.ProgramRun`), never on the
 executor's threads, which go on serving stop, pause, resume and get_state meanwhile; the goal's
 callback only publishes feedback and waits for the end. One program runs at a time. The robot's
 digital I/O (`RobotIO`) lives as long as the node: outputs keep their values from run to run.
@@ -17,9 +17,9 @@ from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.node import Node
 
 from acti_bringup.conversions import fill
-from acti_motion.arm import ArmCore
-from acti_motion.programs import ProgramRun, Status
-from acti_motion.strolic_robot import ProgramDefaults, RobotIO
+from acti_motion.arm.core import ArmCore
+from acti_motion.programs.run import ProgramRun, Status
+from acti_motion.programs.robot import ProgramDefaults, RobotIO
 from strolic.errors import StrolicError
 
 

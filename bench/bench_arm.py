@@ -54,10 +54,10 @@ def accept_latency() -> None:
 
 
 def motion_figures() -> None:
-    from acti_motion.arm import ArmConfig, ArmCore
+    from acti_motion.arm.core import ArmConfig, ArmCore
     from acti_motion.executor import MotionExecutor
-    from acti_motion.poses import orientation_error_deg, pose_to_hg, position_error_mm
-    from acti_motion.trajectories import (CartesianLimits, ConstAccelTiming, LinePath,
+    from acti_motion.arm.poses import orientation_error_deg, pose_to_hg, position_error_mm
+    from acti_motion.arm.trajectories import (CartesianLimits, ConstAccelTiming, LinePath,
                                           load_toppra, time_optimal)
     from acti_sim.world import World
 

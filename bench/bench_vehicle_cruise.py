@@ -9,10 +9,10 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-from acti_motion.base import Pose2D  # noqa: E402
-from acti_motion.cruise import plan_curve, spline_through, time_optimal  # noqa: E402
+from acti_motion.vehicle.paths import Pose2D  # noqa: E402
+from acti_motion.vehicle.cruise import plan_curve, spline_through, time_optimal  # noqa: E402
 from acti_motion.executor import MotionExecutor  # noqa: E402
-from acti_motion.vehicle import VehicleCore  # noqa: E402
+from acti_motion.vehicle.core import VehicleCore  # noqa: E402
 from acti_sim.world import World  # noqa: E402
 
 POINTS_MM = [(1000.0, 0.0), (2000.0, 600.0), (3000.0, 0.0), (4000.0, 600.0), (5000.0, 0.0)]

@@ -9,7 +9,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from acti_motion.executor import MotionExecutor  # noqa: E402
-from acti_motion.vehicle import VehicleCore  # noqa: E402
+from acti_motion.vehicle.core import VehicleCore  # noqa: E402
 from acti_sim.world import World  # noqa: E402
 
 SQUARE = [(5000.0, 0.0, 90.0), (5000.0, 5000.0, 180.0), (0.0, 5000.0, -90.0), (0.0, 0.0, 0.0)]

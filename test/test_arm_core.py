@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from acti_motion.arm import ArmConfig, ArmCore
+from acti_motion.arm.core import ArmConfig, ArmCore
 from acti_motion.replies import ReturnCode
 from sim_fixtures import executor, run_until  # noqa: F401
 

@@ -6,11 +6,11 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from acti_motion.arm import ArmConfig, ArmCore
-from acti_motion.kinematics import wrap
-from acti_motion.poses import hg_to_pose, orientation_error_deg, position_error_mm, pose_to_hg
+from acti_motion.arm.core import ArmConfig, ArmCore
+from acti_motion.arm.kinematics import wrap
+from acti_motion.arm.poses import hg_to_pose, orientation_error_deg, position_error_mm, pose_to_hg
 from acti_motion.replies import ReturnCode as R
-from acti_motion.trajectories import ConstAccelTiming, Trapezoid
+from acti_motion.arm.trajectories import ConstAccelTiming, Trapezoid
 from sim_fixtures import executor, run_until  # noqa: F401
 
 IDENTITY = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from acti_middle_node.operations import COMMON_PORT, EXTENSIONS, MIDDLE_PORT, OPERATIONS
-from acti_motion.arm import ArmConfig, ArmCore
+from acti_motion.arm.core import ArmConfig, ArmCore
 from acti_motion.replies import ReturnCode as R
 from sim_fixtures import executor, run_until  # noqa: F401
 
@@ -274,7 +274,7 @@ def test_alarm_refuses_every_motion_until_cleared(arm, op):
 
 
 def arm_alarm():
-    from acti_motion.arm import Alarm, AlarmType
+    from acti_motion.arm.core import Alarm, AlarmType
     return Alarm(0x5, AlarmType.WARNING, "test")
 
 

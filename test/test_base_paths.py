@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from acti_motion.base import Pose2D, Ramp, arc, line, straight_to, turn, velocity_path
+from acti_motion.vehicle.paths import Pose2D, Ramp, arc, line, straight_to, turn, velocity_path
 
 LIMITS = (0.5, math.radians(45.0), 0.4, math.radians(90.0))
 

@@ -4,8 +4,8 @@ import math
 import numpy as np
 import pytest
 
-from acti_motion.arm import shared_kinematics
-from acti_motion.kinematics import Unreachable, wrap
+from acti_motion.arm.core import shared_kinematics
+from acti_motion.arm.kinematics import Unreachable, wrap
 
 START = np.radians([0.0, 30.0, 0.0, -60.0, 0.0, 60.0, 0.0])
 

@@ -2,8 +2,8 @@
 blocked base stops as Stuck."""
 import pytest
 
-from acti_motion.vehicle import VehicleState
-from acti_motion.vehicle_alarms import AlarmCode
+from acti_motion.vehicle.core import VehicleState
+from acti_motion.vehicle.alarms import AlarmCode
 from sim_fixtures import executor, run_until  # noqa: F401
 from vehicle_fixtures import base, position, ready, settle, state, state_msg, steps  # noqa: F401
 

@@ -4,8 +4,8 @@ import math
 
 import pytest
 
-from acti_motion.base import TrackedBaseMotion
-from acti_motion.vehicle import VehicleState
+from acti_motion.vehicle.paths import TrackedBaseMotion
+from acti_motion.vehicle.core import VehicleState
 from sim_fixtures import executor, run_until  # noqa: F401
 from vehicle_fixtures import assert_at, base, position, ready, settle, state, steps  # noqa: F401
 

@@ -106,7 +106,7 @@ def reference_now(base):
 
 
 def expected_mm(pose, rel):
-    from acti_motion.base import Pose2D
+    from acti_motion.vehicle.paths import Pose2D
     g = pose.compose(Pose2D(rel[0] / 1000.0, rel[1] / 1000.0, math.radians(rel[2])))
     return 1000.0 * g.x, 1000.0 * g.y, math.degrees(g.theta)
 

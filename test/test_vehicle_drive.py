@@ -3,7 +3,7 @@ import math
 
 import pytest
 
-from acti_motion.vehicle import VehicleState
+from acti_motion.vehicle.core import VehicleState
 from sim_fixtures import executor, run_until  # noqa: F401
 from vehicle_fixtures import base, ready, settle, state, steps  # noqa: F401
 

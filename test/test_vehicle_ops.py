@@ -4,8 +4,8 @@ import math
 
 import pytest
 
-from acti_motion.vehicle import FIRMWARE_VERSION, IF_VERSION, VehicleConfig, VehicleCore, VehicleState
-from acti_motion.vehicle_alarms import AlarmCode, AlarmType
+from acti_motion.vehicle.core import FIRMWARE_VERSION, IF_VERSION, VehicleConfig, VehicleCore, VehicleState
+from acti_motion.vehicle.alarms import AlarmCode, AlarmType
 from sim_fixtures import executor, run_until  # noqa: F401
 from vehicle_fixtures import base, ready, settle, state, state_msg, steps  # noqa: F401
 

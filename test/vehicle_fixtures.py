@@ -5,7 +5,7 @@ import math
 
 import pytest
 
-from acti_motion.vehicle import VehicleConfig, VehicleCore, VehicleState
+from acti_motion.vehicle.core import VehicleConfig, VehicleCore, VehicleState
 from sim_fixtures import executor, run_until  # noqa: F401
 
 

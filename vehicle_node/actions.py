@@ -13,7 +13,7 @@ from rclpy.node import Node
 
 from acti_bringup.conversions import fill
 from acti_bringup.waiting import GoalSlots, wait_for_motion
-from acti_motion.vehicle import VehicleCore
+from acti_motion.vehicle.core import VehicleCore
 
 
 @dataclass

@@ -1,4 +1,4 @@
-"""VehicleNode: the thin ROS adapter of `acti_motion.vehicle.VehicleCore`.
+"""VehicleNode: the thin ROS adapter of `acti_motion.vehicle.core.VehicleCore`.
 
 Services: one per IDL operation (operations.py). Action: ~/wait_motion (actions.py).
 Topics (REP 103: m, rad):
@@ -24,10 +24,10 @@ from sensor_msgs.msg import Joy
 from acti_bringup.adapter import serve_operations
 from acti_bringup.parameters import declare_config
 from acti_bringup.simulation import Simulation
-from acti_motion.base import Pose2D
+from acti_motion.vehicle.paths import Pose2D
 from acti_motion.replies import Reply
-from acti_motion.vehicle import VehicleConfig, VehicleCore
-from acti_motion.vehicle_alarms import AlarmType
+from acti_motion.vehicle.core import VehicleConfig, VehicleCore
+from acti_motion.vehicle.alarms import AlarmType
 from acti_sim.world import World
 from vehicle_node.actions import WaitConfig, WaitMotionServer
 from vehicle_node.operations import OPERATIONS

@@ -58,7 +58,7 @@ def test_every_robot_function_has_a_normal_case_and_its_listed_exceptions() -> N
 
 def test_system_and_robot_function_rows() -> None:
     """EE rows have handlers that use the host's hooks; ED rows are the host's (the robot
-    binding, acti_motion/strolic_robot.py, dispatches them by mnemonic)."""
+    binding, acti_motion/programs/robot.py, dispatches them by mnemonic)."""
     host_rows = [row for row in opcodes.TABLE if row.code < 0xEF00]
     assert [row.code for row in host_rows] == (list(range(0xEE00, 0xEE23))
                                                + list(range(0xED00, 0xED24)))

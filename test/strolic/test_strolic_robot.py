@@ -8,9 +8,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from acti_motion.arm import ArmConfig, ArmCore
+from acti_motion.arm.core import ArmConfig, ArmCore
 from acti_motion.executor import MotionExecutor
-from acti_motion.programs import ProgramRun, Status
+from acti_motion.programs.run import ProgramRun, Status
 from acti_sim.world import World
 from sim_fixtures import executor  # noqa: F401
 from strolic.errors import ExceptionKind as K

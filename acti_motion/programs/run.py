@@ -11,8 +11,8 @@ import enum
 import threading
 from dataclasses import dataclass, field
 
-from acti_motion.arm import ArmCore
-from acti_motion.strolic_robot import ProgramDefaults, RobotHost
+from acti_motion.arm.core import ArmCore
+from acti_motion.programs.robot import ProgramDefaults, RobotHost
 from strolic.codec import decode
 from strolic.errors import ExceptionKind as K, StrolicError
 from strolic.host import MemoryIO

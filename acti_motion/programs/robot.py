@@ -24,12 +24,12 @@ from typing import Callable
 
 import numpy as np
 
-from acti_motion.arm import ArmCore
-from acti_motion.blending import ARM_MOVES, blend_with_previous
-from acti_motion.kinematics import Unreachable, rotate_about
-from acti_motion.poses import compose_relative, hg_to_pose, inverse
+from acti_motion.arm.core import ArmCore
+from acti_motion.arm.blending import ARM_MOVES, blend_with_previous
+from acti_motion.arm.kinematics import Unreachable, rotate_about
+from acti_motion.arm.poses import compose_relative, hg_to_pose, inverse
 from acti_motion.replies import Refused, ReturnCode, value_error
-from acti_motion.trajectories import ArcPath, ArmSetpoint, LinePath
+from acti_motion.arm.trajectories import ArcPath, ArmSetpoint, LinePath
 from strolic.codes import (I2, NUMERIC_TAGS, POSE, R4, R8, Array, Num, Pose, Str, TagHead,
                            Trn, make_real)
 from strolic.errors import ExceptionKind as K, StrolicError, fail

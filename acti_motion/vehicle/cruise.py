@@ -16,7 +16,7 @@ from typing import Sequence
 
 import numpy as np
 
-from acti_motion.base import (Chain, CurvePath, Odometry, Path, Pose2D, SampledPath,
+from acti_motion.vehicle.paths import (Chain, CurvePath, Odometry, Path, Pose2D, SampledPath,
                               TrackedBaseMotion, straight_to, turn, velocity_path, wrap_angle)
 
 SAMPLE_DT = 0.005            # s between samples of the timed path

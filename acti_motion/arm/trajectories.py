@@ -20,8 +20,8 @@ import numpy as np
 import pinocchio as pin
 from scipy.interpolate import CubicSpline
 
-from acti_motion.kinematics import ArmKinematics, Unreachable, rotate_about, wrap
-from acti_motion.poses import Frames, rotation_angle
+from acti_motion.arm.kinematics import ArmKinematics, Unreachable, rotate_about, wrap
+from acti_motion.arm.poses import Frames, rotation_angle
 from acti_motion.profiles import Trapezoid
 from acti_sim.world import World
 

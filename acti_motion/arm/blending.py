@@ -22,7 +22,7 @@ from typing import Callable
 import numpy as np
 
 from acti_motion.executor import Device
-from acti_motion.trajectories import ArmSetpoint
+from acti_motion.arm.trajectories import ArmSetpoint
 
 ARM_MOVES = ("joint", "cartesian")
 SEAM_MARGIN = 0.02         # s: a running move is not cut closer than this to where it is now

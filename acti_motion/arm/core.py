@@ -7,7 +7,7 @@ that operation (`@returns`). Units are the spec's: mm, degree, mm/s, degree/s, s
 Frames: the arm frame is `base_link`; the robot frame is the arm frame moved by the base offset
 (setBaseOffset gives the robot frame seen from the arm frame); the control point is the flange
 moved by the control-point offset. Every Cartesian value of the ports is the control point in
-the robot frame. `elbow` is the arm angle in degrees (see `acti_motion.kinematics`);
+the robot frame. `elbow` is the arm angle in degrees (see `acti_motion.arm.kinematics`);
 `struct_flag` reports the posture's branch (bits 0x1 θ2 < 0, 0x2 θ4 > 0, 0x4 θ6 < 0) and is
 ignored on input: moves take the branch nearest to where they start.
 """
@@ -23,12 +23,12 @@ from typing import Any, Callable
 import numpy as np
 
 from acti_motion.executor import MotionExecutor
-from acti_motion.kinematics import ArmKinematics, Unreachable, rotate_about
-from acti_motion.poses import (Frames, compose_relative, hg_to_pose, pose_to_hg)
+from acti_motion.arm.kinematics import ArmKinematics, Unreachable, rotate_about
+from acti_motion.arm.poses import (Frames, compose_relative, hg_to_pose, pose_to_hg)
 from acti_motion.profiles import Trapezoid
 from acti_motion.replies import (Refused, Reply, ReturnCode, finite_number, finite_vector,
                                  ratio_percent, returns, value_error)
-from acti_motion.trajectories import (ArcPath, ArmMotion, ArmSetpoint, CartesianLimits,
+from acti_motion.arm.trajectories import (ArcPath, ArmMotion, ArmSetpoint, CartesianLimits,
                                       CartesianPlanner, LinearJointPath, LinePath, load_toppra)
 from acti_sim.world import GRIPPER_JOINTS
 

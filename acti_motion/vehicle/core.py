@@ -15,12 +15,12 @@ from dataclasses import dataclass
 from enum import IntEnum
 from typing import Any, Callable
 
-from acti_motion.base import (BrakeMotion, Odometry, Path, Pose2D, TrackedBaseMotion, arc, line,
+from acti_motion.vehicle.paths import (BrakeMotion, Odometry, Path, Pose2D, TrackedBaseMotion, arc, line,
                               straight_to, turn, velocity_path)
-from acti_motion.cruise import CruiseMotion, transition_to
+from acti_motion.vehicle.cruise import CruiseMotion, transition_to
 from acti_motion.executor import Device, MotionExecutor
 from acti_motion.replies import Refused, ReturnCode, answers, finite_number
-from acti_motion.vehicle_alarms import AlarmCode, Alarms, AlarmType, Kind
+from acti_motion.vehicle.alarms import AlarmCode, Alarms, AlarmType, Kind
 from acti_sim.battery import Battery, BatteryModel
 from acti_sim.io_module import IoModule
 from acti_sim.world import World

@@ -1,0 +1,1 @@
+"""STROLIC programs on the arm: the robot host (ED functions, `robot`) and one program run (`run`)."""
