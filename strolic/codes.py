@@ -132,6 +132,15 @@ def make_number(tag: int, value: int | float) -> Num:
     return make_int(tag, int(value)) if tag <= I4 else make_real(tag, float(value))
 
 
+def converted(num: Num, tag: int) -> int | float:
+    """Annex 1 §5: the value of ``num`` in the stronger representation ``tag`` (I1 < I2 < I4 <
+    R4 < R8), where mixed arithmetic is done: an integer going to R4 is rounded to single
+    precision (I4 33554433 becomes 33554432), every other conversion is exact."""
+    if tag <= I4:
+        return num.value
+    return to_float32(float(num.value)) if tag == R4 else float(num.value)
+
+
 def smallest_int(value: int) -> Num:
     """The minimal integer type holding ``value`` (INT, LNG, lengths, bare literals)."""
     for tag in INTEGER_TAGS:

@@ -1,16 +1,19 @@
 """EF00–EF0F, EF1B, EF27–EF35: arithmetic, comparison, NOT, sign, conversion, ε, π, angles.
 
-Mixed arithmetic (Annex 1 §5): both operands go to the stronger type I1 < I2 < I4 < R4 < R8 and
-so does the result. An integer result that does not fit its type is numeric overflow (only
-INC/DEC wrap, as their remarks say; NEG is two's complement, so it wraps too).
+Mixed arithmetic (Annex 1 §5): both operands are first converted to the stronger representation
+I1 < I2 < I4 < R4 < R8 (an I4 going to R4 is rounded to single precision), the operation is done
+in it and the result has it; DIV converts its operands the same way and gives R8 (its table).
+LEQ/GEQ/LT/GT compare in the stronger representation too. An integer result that does not fit
+its type is numeric overflow (only INC/DEC wrap, as their remarks say; NEG is two's complement,
+so it wraps too).
 """
 from __future__ import annotations
 
 import math
 from typing import TYPE_CHECKING, Callable
 
-from ..codes import (I2, I4, INT_RANGE, R4, R8, Num, logical, make_int, make_number, make_real,
-                     smallest_int, to_float32, wrap_int)
+from ..codes import (I2, I4, INT_RANGE, R4, R8, Num, converted, logical, make_int, make_number,
+                     make_real, smallest_int, to_float32, wrap_int)
 from ..errors import ExceptionKind as K, fail
 from ..process import Process
 from .args import pop_int, pop_num, pop_real
@@ -27,6 +30,13 @@ def _pop_pair(proc: Process, pop=pop_num) -> tuple[Num, Num]:
     return a, b
 
 
+def _promoted(proc: Process, pop=pop_num) -> tuple[int, int | float, int | float]:
+    """a b: the stronger representation of the two and both values converted to it (§5)."""
+    a, b = _pop_pair(proc, pop)
+    tag = max(a.tag, b.tag)
+    return tag, converted(a, tag), converted(b, tag)
+
+
 def _checked_real(tag: int, value: float, *operands: float) -> Num:
     """A real result; 0 computed from non-zero ``operands`` (of ×, ÷, ^) is underflow (§9)."""
     if value == 0.0 and operands and all(operands):
@@ -36,16 +46,15 @@ def _checked_real(tag: int, value: float, *operands: float) -> Num:
 
 def binary_arithmetic(int_op: Callable[[int, int], int], real_op: Callable[[float, float], float],
                       underflow_check: bool = False) -> Handler:
-    """ADD, SUB, MUL: the result in the stronger type."""
+    """ADD, SUB, MUL: done in the stronger representation. Single precision + − × are exact
+    in double, so one rounding of the double result gives the single precision result."""
     def handler(vm: VM, proc: Process) -> None:
-        a, b = _pop_pair(proc)
-        tag = max(a.tag, b.tag)
+        tag, a, b = _promoted(proc)
         if tag <= I4:
-            proc.push(make_int(tag, int_op(a.value, b.value)))
+            proc.push(make_int(tag, int_op(a, b)))
         else:
-            value = real_op(float(a.value), float(b.value))
-            operands = (a.value, b.value) if underflow_check else ()
-            proc.push(_checked_real(tag, value, *operands))
+            operands = (a, b) if underflow_check else ()
+            proc.push(_checked_real(tag, real_op(a, b), *operands))
     return handler
 
 
@@ -55,31 +64,31 @@ mul = binary_arithmetic(lambda x, y: x * y, lambda x, y: x * y, underflow_check=
 
 
 def div(vm: VM, proc: Process) -> None:
-    """DIV: real division, always R8."""
-    a, b = _pop_pair(proc)
-    if b.value == 0:
+    """DIV: the operands converted to the stronger representation (§5), the quotient in R8 (the
+    output its table gives: a ÷ b, not an integer division)."""
+    _, a, b = _promoted(proc)
+    if b == 0:
         raise fail(K.DIVISION_BY_ZERO, "DIV by 0")
-    proc.push(_checked_real(R8, a.value / b.value, a.value, b.value))
+    proc.push(_checked_real(R8, a / b, a, b))
 
 
 def pwr(vm: VM, proc: Process) -> None:
     """PWR: a^b in the stronger type; b < 0 is handled as division by 0."""
-    a, b = _pop_pair(proc)
-    if b.value < 0:
+    tag, a, b = _promoted(proc)
+    if b < 0:
         raise fail(K.DIVISION_BY_ZERO, "PWR with a negative exponent")
-    tag = max(a.tag, b.tag)
     if tag <= I4:
-        if abs(a.value) > 1 and b.value > 64:
+        if abs(a) > 1 and b > 64:
             raise fail(K.NUMERIC_OVERFLOW, "PWR result too large")
-        proc.push(make_int(tag, a.value ** b.value))
+        proc.push(make_int(tag, a ** b))
         return
-    if a.value < 0 and not float(b.value).is_integer():
+    if a < 0 and not b.is_integer():
         raise fail(K.UNDEFINED_DATA, "negative base with a fractional exponent")
     try:
-        value = math.pow(a.value, b.value)
+        value = math.pow(a, b)
     except OverflowError:
         raise fail(K.NUMERIC_OVERFLOW, "PWR result too large") from None
-    proc.push(_checked_real(tag, value, a.value))
+    proc.push(_checked_real(tag, value, a))
 
 
 def _integer_division(vm: VM, proc: Process) -> tuple[int, Num, Num]:
@@ -122,25 +131,34 @@ def _equal(a: Num, b: Num) -> bool:
     return a.tag == b.tag and a.value == b.value
 
 
-def comparison(test: Callable[[Num, Num], bool]) -> Handler:
+def equality(equal: bool) -> Handler:
+    """EQU, NEQ: by their remarks, not by conversion."""
     def handler(vm: VM, proc: Process) -> None:
         a, b = _pop_pair(proc)
+        proc.push(logical(_equal(a, b) == equal))
+    return handler
+
+
+def ordering(test: Callable[[int | float, int | float], bool]) -> Handler:
+    """LEQ, GEQ, LT, GT: in the stronger representation, as the arithmetic (§5), so that
+    ``a b LT`` agrees with the sign of ``a b SUB``."""
+    def handler(vm: VM, proc: Process) -> None:
+        _, a, b = _promoted(proc)
         proc.push(logical(test(a, b)))
     return handler
 
 
-equ = comparison(_equal)
-neq = comparison(lambda a, b: not _equal(a, b))
-leq = comparison(lambda a, b: a.value <= b.value)
-geq = comparison(lambda a, b: a.value >= b.value)
-lt = comparison(lambda a, b: a.value < b.value)
-gt = comparison(lambda a, b: a.value > b.value)
+equ, neq = equality(True), equality(False)
+leq = ordering(lambda a, b: a <= b)
+geq = ordering(lambda a, b: a >= b)
+lt = ordering(lambda a, b: a < b)
+gt = ordering(lambda a, b: a > b)
 
 
 def aeq(vm: VM, proc: Process) -> None:
     """AEQ: |a − b| < ε (ε set by SEPS)."""
-    a, b = _pop_pair(proc, pop_real)
-    proc.push(logical(abs(a.value - b.value) < vm.eps))
+    _, a, b = _promoted(proc, pop_real)
+    proc.push(logical(abs(a - b) < vm.eps))
 
 
 def not_(vm: VM, proc: Process) -> None:
@@ -241,5 +259,5 @@ raddeg = real_function(math.degrees)
 
 def atan2(vm: VM, proc: Process) -> None:
     """ATAN2: a is y, b is x; the usual quadrant rule (atan2(0, x<0) = π)."""
-    a, b = _pop_pair(proc, pop_real)
-    proc.push(make_real(max(a.tag, b.tag), math.atan2(a.value, b.value)))
+    tag, a, b = _promoted(proc, pop_real)
+    proc.push(make_real(tag, math.atan2(a, b)))

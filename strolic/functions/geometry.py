@@ -10,7 +10,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..codes import I2, R4, R8, Num, Pose, Trn, Vec, make_int, make_real, to_float32
+from ..codes import (I2, R4, R8, Num, Pose, Trn, Vec, converted, make_int, make_real,
+                     to_float32)
 from ..errors import ExceptionKind as K, fail
 from ..process import Process
 from .args import expect, pop_count, pop_many, pop_num, pop_of
@@ -70,8 +71,10 @@ vprodo = vector_binary(np.cross)
 
 
 def vtimes(vm: VM, proc: Process) -> None:
-    """VTIMES: a b → b·a (vector first, scalar on top)."""
-    scale = float(pop_num(proc).value)
+    """VTIMES: a b → b·a (vector first, scalar on top); the scalar is converted to the stronger
+    of its representation and the elements' R4 first (Annex 1 §5: an I4 is rounded to R4)."""
+    scale = pop_num(proc)
+    scale = converted(scale, max(scale.tag, R4))
     proc.push(vec_of(np.array(pop_vec(proc).xyz) * scale))
 
 
