@@ -1,14 +1,16 @@
 """The variable table of Reference 1: user codes → heap areas, in nested scopes (§5, §6, §8).
 
 A binding holds a value and, once bytes are addressed (ALLOC, EXTB, EMBB …), its *area*: the
-data part as a bytearray under a head. The value is rebuilt from the area after a write, so
-structured data stays a plain immutable value everywhere else.
+tag (``head``) and the data part as a bytearray. The value is rebuilt from the area after a
+write, so structured data stays a plain immutable value everywhere else. The size of an area is
+that of the tagged datum, tag included (EF67: ALLOC secures a plus the length of the tag and
+writes the tag into it); a value without an area counts as the tagged datum it would fill.
 """
 from __future__ import annotations
 
-from .codes import ARRAY, DATA_TYPES, LENGTH_TAGS, TagHead, type_name
+from .codes import ARRAY, LENGTH_TAGS, TagHead, type_name
 from .errors import ExceptionKind as K, fail
-from .values import data_of, encode_item, head_of, value_from_data
+from .values import data_of, encode_head, encode_item, head_of, value_from_data
 
 
 class Binding:
@@ -39,14 +41,7 @@ class Binding:
         self._value, self.head, self.area = value, None, None
 
     def allocate(self, head: TagHead, size: int) -> None:
-        """ALLOC: an area of ``size`` data bytes under ``head`` (lengths set to ``size``)."""
-        if head.tag in LENGTH_TAGS or head.tag == ARRAY:
-            head = TagHead(head.tag, size, head.element)
-            element_size = head.element.element_size() if head.tag == ARRAY else 0
-            if element_size and size % element_size:
-                raise fail(K.TYPE_MISMATCH, "area size is not a multiple of the element size")
-        elif size < head.element_size():
-            raise fail(K.AREA_ERROR, f"{size} bytes cannot hold {type_name(head)} data")
+        """ALLOC: a zeroed area of ``size`` data bytes under ``head`` (an ``area_head``)."""
         self._value, self.head, self.area = None, head, bytearray(size)
 
     def bytes_area(self) -> bytearray:
@@ -62,16 +57,33 @@ class Binding:
         self._value = None
 
     def size(self) -> int | None:
+        """Bytes of the area, tag included (ASIZE, the heap); None without a value."""
         if self.area is not None:
-            return len(self.area)
+            return len(encode_head(self.head)) + len(self.area)
         if self._value is None:
             return None
-        if isinstance(self._value, DATA_TYPES):
-            return len(data_of(self._value))
         return len(encode_item(self._value))
 
     def release(self) -> None:
         self._value, self.head, self.area = None, None, None
+
+
+def area_head(head: TagHead, size: int) -> TagHead:
+    """ALLOC's tag for ``size`` data bytes: lengths are set to ``size`` (an array needs a
+    multiple of its element size); a fixed type needs at least its size."""
+    if head.tag in LENGTH_TAGS or head.tag == ARRAY:
+        element_size = head.element.element_size() if head.tag == ARRAY else 0
+        if element_size and size % element_size:
+            raise fail(K.TYPE_MISMATCH, "area size is not a multiple of the element size")
+        return TagHead(head.tag, size, head.element)
+    if size < head.element_size():
+        raise fail(K.AREA_ERROR, f"{size} bytes cannot hold {type_name(head)} data")
+    return head
+
+
+def area_size(head: TagHead, size: int) -> int:
+    """EF67: the area ALLOC secures is ``size`` plus the length of the tag written into it."""
+    return len(encode_head(head)) + size
 
 
 class Scope:

@@ -2,7 +2,8 @@
 arrays, user codes and heap areas.
 
 Offsets of EXTB/EMBB count from 0 at the first byte of the data part (Reference 1 §7) and must
-stay inside the area of the user code (which ALLOC may make larger than the value).
+stay inside the data part of the area of the user code (which ALLOC may make larger than the
+value); the tag at the start of the area is not addressed.
 """
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ from ..codes import (ARRAY, DATA_TYPES, I1, I2, I4, INDIRECT, INT_RANGE, NUMERIC
 from ..errors import ExceptionKind as K, fail
 from ..process import Process
 from ..values import array_elements, data_of, head_of, value_from_data
-from ..variables import find
+from ..variables import area_head, area_size, find
 from .args import (expect, integer_value, pop_count, pop_head, pop_many, pop_num, pop_of,
                    pop_user)
 
@@ -185,9 +186,10 @@ def _heap_in_use(vm) -> int:
 
 
 def alloc(vm: VM, proc: Process) -> None:
-    """ALLOC and ALLOCZ a #b #c: a data bytes under tag b for c; 0 asks the free size; a
-    shortfall is returned negative. Every area starts zeroed (the Null code is 0x00), so the
-    two functions are one."""
+    """ALLOC and ALLOCZ a #b #c (EF67, EF68): an area of a bytes plus the tag b, which is
+    written into it, for c; d is the size of the area (tag included). a ≤ 0 asks the largest
+    size that could be secured; a shortfall is returned negative (nothing secured). Every area
+    starts zeroed (the Null code is 0x00), so the two functions are one."""
     target = pop_user(proc)
     head = pop_head(proc)
     size = pop_count(proc)
@@ -195,16 +197,20 @@ def alloc(vm: VM, proc: Process) -> None:
     free_bytes = vm.heap_limit - _heap_in_use(vm)
     if size <= 0:
         proc.push(smallest_int(free_bytes))
-    elif size > free_bytes:
-        proc.push(smallest_int(free_bytes - size))
+        return
+    if head.tag in (SUPPRESS, INDIRECT):
+        raise fail(K.TYPE_MISMATCH, "cannot allocate an area for this tag")
+    head = area_head(head, size)
+    needed = area_size(head, size)
+    if needed > free_bytes:
+        proc.push(smallest_int(free_bytes - needed))
     else:
-        if head.tag in (SUPPRESS, INDIRECT):
-            raise fail(K.TYPE_MISMATCH, "cannot allocate an area for this tag")
         binding.allocate(head, size)
-        proc.push(smallest_int(size))
+        proc.push(smallest_int(needed))
 
 
 def aclr(vm: VM, proc: Process) -> None:
+    """ACLR: the data part of the area becomes Null codes; its tag stays."""
     binding = binding_of(proc, pop_user(proc))
     if binding.defined:
         area = binding.bytes_area()
@@ -217,6 +223,7 @@ def arels(vm: VM, proc: Process) -> None:
 
 
 def asize(vm: VM, proc: Process) -> None:
-    """ASIZE: data bytes of the area (I2, or I4 when larger), −1 when there is none."""
+    """ASIZE: bytes of the area, tag included as ALLOC counts them (I2, or I4 when larger),
+    −1 when there is none."""
     size = binding_of(proc, pop_user(proc)).size()
     proc.push(Num(I2, -1) if size is None else make_number(I2 if size <= 0x7FFF else I4, size))

@@ -209,7 +209,9 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
              ("#x I4:0x01020304 STORE #x 1 #I2 EXTB", ["515"]),
              ("#x Vec(1 2 3) STORE #x 4 #R4 EXTB", ["R4:2.0"]),
              ('#x "AB" STORE #x 1 #I2 EXTB', AREA), ('#x "AB" STORE #x -1 #I1 EXTB', AREA),
-             ("#x 0 #I1 EXTB", AREA), ('#x "AB" STORE #x 0 1 EXTB', TYPE)],
+             ("#x 0 #I1 EXTB", AREA), ('#x "AB" STORE #x 0 1 EXTB', TYPE),
+             ("2 #I2 #x ALLOC DROP #x 1 #I1 EXTB", ["0"]),   # offsets count in the data part:
+             ("2 #I2 #x ALLOC DROP #x 1 #I2 EXTB", AREA)],   # the tag byte adds no room
     "EMBB": [('#x "ABCD" STORE #x 1 "zz" EMBB x', ['"AzzD"']),
              ("#x I2:0 STORE #x 1 5 EMBB x", ["I2:5"]),
              ('#x "AB" STORE #x 1 "zz" EMBB', AREA), ('#x "AB" STORE #x -1 "z" EMBB', AREA),
@@ -267,18 +269,25 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
     "FREE": [("VAR #%2000 DCL VAR #%2000 FREE %2000", UNDEF), ("VAR #%2001 FREE 1", ["1"])],
     "VAR": [("VAR", ["#VAR"])],
     # ---- heap areas ---------------------------------------------------------------------------------------------------
-    "ALLOC": [("12 #Ar(0, I2) #x ALLOC x", ["12", "Ar[I2 0 0 0 0 0 0]"]),
+    # EF67: the area is a plus the tag written into it (F9 F1 0C F2 here), d its size
+    "ALLOC": [("12 #Ar(0, I2) #x ALLOC x", ["16", "Ar[I2 0 0 0 0 0 0]"]),
+              ("2 #I2 #x ALLOC x", ["3", "I2:0"]), ("12 #Vec #x ALLOC", ["14"]),
+              ("200 #St(0) #x ALLOC #x ASIZE", ["204", "204"]),    # FA F2 00 C8: 4 bytes
+              ("R4:2.5 #I2 #x ALLOC", ["4"]),                         # a rounded (§6) to 3
               ("4 #I2 #x ALLOC DROP #x 2 I2:7 EMBB #x 2 #I2 EXTB x", ["I2:7", "I2:0"]),
               ("0 #I2 #x ALLOC 0 GT", [T]), ("I4:100000000 #St(0) #x ALLOC 0 LT", [T]),
               ("12 #I2 #%2000 ALLOC", UNDEF), ("13 #Ar(0, I2) #x ALLOC", TYPE),
               ("1 #I2 #x ALLOC", AREA), ("4 ## #x ALLOC", TYPE)],
-    "ALLOCZ": [("3 #St(0) #x ALLOCZ x", ["3", '"\\x00\\x00\\x00"']),
-               ("#x 5 STORE 4 #R4 #x ALLOCZ x", ["4", "R4:0.0"])],
-    "ACLR": [('#x "AB" STORE #x ACLR x', ['"\\x00\\x00"']), ("#x ACLR 1", ["1"])],
+    "ALLOCZ": [("3 #St(0) #x ALLOCZ x", ["6", '"\\x00\\x00\\x00"']),
+               ("#x 5 STORE 4 #R4 #x ALLOCZ x", ["5", "R4:0.0"])],
+    "ACLR": [('#x "AB" STORE #x ACLR x', ['"\\x00\\x00"']), ("#x ACLR 1", ["1"]),
+             ("4 #I2 #x ALLOC DROP #x 0 I2:7 EMBB #x ACLR x #x ASIZE", ["I2:0", "I2:5"])],
     "ARELS": [("#x 5 STORE #x ARELS #x ASIZE", ["I2:-1"]), ("#x 5 STORE #x ARELS x", UNDEF),
               ("#x ARELS 1", ["1"])],
-    "ASIZE": [('#x "ABC" STORE #x ASIZE', ["I2:3"]), ("#x ASIZE", ["I2:-1"]),
-              ("300 #St(0) #x ALLOC DROP #x ASIZE", ["300"])],
+    # the area of a value, like ALLOC's, holds its tag too (FA F1 03 "ABC")
+    "ASIZE": [('#x "ABC" STORE #x ASIZE', ["I2:6"]), ("#x ASIZE", ["I2:-1"]),
+              ("300 #St(0) #x ALLOC DROP #x ASIZE", ["304"]),
+              ("2 #I2 #x ALLOC #x ASIZE EQU", [T]), ("#x #y STORE #x ASIZE", ["I2:3"])],
     # ---- identification, INIT, trace, exchange --------------------------------------------------------------------
     "VERID": [("VERID", ['"STROLIC JIS B 8440-1994"'])],
     "SYSID": [("SYSID LNG 0 GT", [T])],
@@ -339,7 +348,7 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
     # ---- EE: time of day, date, internal clock --------------------------------------------------
     "TIME": [("TIME", ['"07:08:09"'])],
     "DATE": [("DATE", ['"2024/05/06"'])],
-    "CLOCK": [("CLOCK 0 GEQ", [T]), ("#x CLOCK STORE #x ASIZE", ["I2:4"])],
+    "CLOCK": [("CLOCK 0 GEQ", [T]), ("#x CLOCK STORE #x ASIZE", ["I2:5"])],        # an I4
     "STIME": [('"23:59:58" STIME TIME', ['"23:59:58"']), ('"00:00:00" STIME TIME DATE',
                ['"00:00:00"', '"2024/05/06"']),
               ('"24:00:00" STIME TIME', Warns(['"07:08:09"'])),

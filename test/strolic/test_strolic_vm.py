@@ -210,3 +210,21 @@ def test_variables_persist_between_runs_of_one_vm() -> None:
     vm = VM()
     vm.run(assemble(".name x %1000 VAR #x DCL #x 41 STORE"))
     assert [item.value for item in vm.run(assemble("%1000 INC")).stack] == [42]
+
+
+def test_heap_counts_areas_with_their_tags_and_free_gives_them_back() -> None:
+    """EF67: ALLOC secures a plus the tag; the heap holds the tagged data of every registration
+    (shadowed ones too), DCL takes nothing, FREE and ARELS give the area back."""
+    free = "0 #I2 #x ALLOC"
+    program = (f"{free} "                              # 1000 free
+               "100 #St(0) #y ALLOC "                  # FA F1 64 + 100 bytes = 103
+               f"{free} "                              # 897
+               "VAR #y DCL #y 5 STORE "                # a new registration holding F1 05
+               f"{free} "                              # 895: the shadowed one still counts
+               f"VAR #y FREE {free} "                  # 897
+               f"#y ARELS {free} "                     # 1000
+               "996 #St(0) #y ALLOC "                  # FA F2 03 E4 + 996 = 1000: fits
+               f"{free} #y ARELS "                     # 0
+               "997 #St(0) #y ALLOC #y ASIZE")          # 1001: one short, nothing secured
+    assert stack_of(program, heap_limit=1000) == ["1000", "103", "897", "895", "897", "1000",
+                                                  "1000", "0", "-1", "I2:-1"]
