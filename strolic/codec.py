@@ -2,7 +2,9 @@
 
 A program is a list of ``Code``: a datum to push, a suppressed item (``#…``), an indirect
 reference (``F7 u``) or a function code (built-in or user). Function data bodies are decoded
-too, so a program that decodes is syntactically valid all the way down.
+too, so a program that decodes is syntactically valid all the way down. A length written in
+the longer form §6.2 allows is kept in ``Code.head``, so decoding and encoding again gives the
+same bytes (branch offsets in function bodies stay right through the text form too).
 """
 from __future__ import annotations
 
@@ -10,10 +12,10 @@ import enum
 from dataclasses import dataclass
 
 from . import opcodes
-from .codes import (END_CODE, FUNCTION, INDIRECT, SUPPRESS, Function, FunctionCode, UserCode,
-                    is_user_code)
-from .values import (MAX_NESTING, Reader, encode_function_code, encode_item, encode_value, invalid,
-                     value_from_data)
+from .codes import (END_CODE, FUNCTION, INDIRECT, SUPPRESS, Function, FunctionCode, TagHead,
+                    UserCode, is_user_code)
+from .values import (MAX_NESTING, Reader, data_of, encode_function_code, encode_head, encode_item,
+                     encode_value, invalid, value_from_data)
 
 
 class CodeKind(enum.Enum):
@@ -29,6 +31,12 @@ class Code:
     value: object
     offset: int
     size: int
+    head: TagHead | None = None   # a datum's or #tag's head as written, when not canonical
+
+
+def written(head: TagHead) -> TagHead | None:
+    """The ``Code.head`` to keep for ``head``: None when its lengths are in the smallest form."""
+    return None if head == head.canonical() else head
 
 
 EXTENDED_PREFIX = 0xEB   # first byte of the 4-byte user codes decoded here (EA… is 2-byte)
@@ -53,10 +61,11 @@ def read_code(reader: Reader, depth: int) -> Code:
     if first == SUPPRESS:
         second = reader.byte()
         if second >= FIRST_TAG:
-            item: object = reader.head(second)
-        else:
-            code = read_function_code(reader, second)
-            item = UserCode(code) if is_user_code(code) else FunctionCode(code)
+            head = reader.head(second)
+            return Code(CodeKind.SUPPRESSED, head.canonical(), start, reader.offset - start,
+                        written(head))
+        code = read_function_code(reader, second)
+        item = UserCode(code) if is_user_code(code) else FunctionCode(code)
         return Code(CodeKind.SUPPRESSED, item, start, reader.offset - start)
     if first == INDIRECT:
         second = reader.byte()
@@ -69,12 +78,12 @@ def read_code(reader: Reader, depth: int) -> Code:
         if head.tag == INDIRECT:
             raise invalid("indirect reference without user code", start)
         data_offset = reader.offset
-        value = value_from_data(head, reader.take(head.element_size()), data_offset)
+        value = value_from_data(head.canonical(), reader.take(head.element_size()), data_offset)
         if head.tag == FUNCTION:
             if depth >= MAX_NESTING:
                 raise invalid(f"function data nested deeper than {MAX_NESTING}", start)
             decode(value.body, data_offset, function_body=True, depth=depth + 1)
-        return Code(CodeKind.DATA, value, start, reader.offset - start)
+        return Code(CodeKind.DATA, value, start, reader.offset - start, written(head))
     return Code(CodeKind.CALL, read_function_code(reader, first), start, reader.offset - start)
 
 
@@ -97,6 +106,11 @@ def decode_function(function: Function) -> list[Code]:
 
 
 def encode_code(code: Code) -> bytes:
+    if code.head is not None:
+        head = encode_head(code.head)
+        if code.kind is CodeKind.DATA:
+            return head + data_of(code.value)
+        return bytes([SUPPRESS]) + head
     if code.kind is CodeKind.DATA:
         return encode_value(code.value)
     if code.kind is CodeKind.CALL:

@@ -170,12 +170,21 @@ def logical(flag: bool) -> Num:
 class TagHead:
     """A tag with its length (St, Rd, Fn, Pm, Ar) and, for Ar, the element head.
 
-    Pushed on the stack by ``#tag`` (§6.2); also the element type of arrays.
+    Pushed on the stack by ``#tag`` (§6.2); also the element type of arrays. ``length_tag`` is
+    the integer tag a length was written with when that is not its smallest form (§6.2 allows a
+    2- or 4-byte integer above 127: I4 for a length that fits I2); the codec keeps it so that
+    code re-encodes as it was read. Stack items and values hold ``canonical`` heads only.
     """
 
     tag: int
     length: int | None = None
     element: "TagHead | None" = None
+    length_tag: int | None = None
+
+    def canonical(self) -> "TagHead":
+        """The same head with every length in its smallest form."""
+        element = self.element.canonical() if self.element is not None else None
+        return TagHead(self.tag, self.length, element)
 
     def element_size(self) -> int:
         """Bytes one value of this head takes without its head (array elements, EXTB)."""

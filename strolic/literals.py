@@ -36,11 +36,14 @@ def format_string(data: bytes) -> str:
 
 
 def format_head(head: TagHead) -> str:
+    """``St(3)``, ``Ar(6, I2)``; a length in a longer form than its smallest is typed:
+    ``St(I4:200)``."""
     name = TAG_NAMES[head.tag]
+    length = format_number(Num(head.length_tag, head.length)) if head.length_tag else head.length
     if head.tag == ARRAY:
-        return f"{name}({head.length}, {format_head(head.element)})"
+        return f"{name}({length}, {format_head(head.element)})"
     if head.tag in LENGTH_TAGS:
-        return f"{name}({head.length})"
+        return f"{name}({length})"
     return name
 
 

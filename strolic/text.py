@@ -8,14 +8,14 @@ from __future__ import annotations
 import re
 
 from . import opcodes
-from .codec import Code, CodeKind, decode, decode_function, encode, encode_code
+from .codec import Code, CodeKind, decode, decode_function, encode, encode_code, written
 from .codes import (ARRAY, FUNCTION, I2, INDIRECT, LENGTH_TAGS, NUMERIC_TAGS, R8, REAL_TAGS,
                     SUPPRESS, TAGS_BY_NAME, Array, Function, FunctionCode, Num, Pose, Record, Str,
                     TagHead, Trn, UserCode, Vec, is_user_code, make_number, smallest_int,
                     to_float32)
 from .errors import ExceptionKind as K, StrolicError
-from .literals import format_user_code, format_value
-from .values import MAX_NESTING, data_of, head_of, value_from_data
+from .literals import format_head, format_user_code, format_value
+from .values import MAX_NESTING, data_of, head_of, length_tag_of, value_from_data
 
 TOKEN = re.compile(r'''(?P<skip>[\s,]+|;[^\n]*)
                      |(?P<string>"(?:[^"\\]|\\.)*")
@@ -118,7 +118,12 @@ class Assembler:
 
     def code_from(self, kind: str, word: str) -> Code:
         if kind == "word" and word.startswith("#") and len(word) > 1:
-            return Code(CodeKind.SUPPRESSED, self.suppressed(word[1:]), 0, 0)
+            item = self.suppressed(word[1:])
+            if isinstance(item, TagHead):
+                return Code(CodeKind.SUPPRESSED, item.canonical(), 0, 0, written(item))
+            return Code(CodeKind.SUPPRESSED, item, 0, 0)
+        if kind == "word" and word.startswith("=") and len(word) > 1:
+            return self.written_datum(self.head(word[1:]))
         if kind == "word" and word.startswith("@"):
             return Code(CodeKind.INDIRECT, self.user_code(word[1:]), 0, 0)
         if kind == "word" and word == "Fn" and self.peek() and self.peek()[1] == "{":
@@ -135,6 +140,15 @@ class Assembler:
                     else self.user_code(word))
             return Code(CodeKind.CALL, code, 0, 0)
         return Code(CodeKind.DATA, self.literal(kind, word), 0, 0)
+
+    def written_datum(self, head: TagHead) -> Code:
+        """``=St(I4:200) "…"``: the datum that follows, written with ``head`` (its lengths in
+        the forms given)."""
+        kind, word, line = self.next()
+        code = self.code(kind, word, line)
+        if code.kind is not CodeKind.DATA or head_of(code.value) != head.canonical():
+            raise AsmError(f"the head ={format_head(head)} does not describe {word!r}", line)
+        return Code(CodeKind.DATA, code.value, 0, 0, written(head))
 
     def user_code(self, word: str) -> int:
         if word in self.names:
@@ -167,18 +181,25 @@ class Assembler:
             raise self.error(f"{name!r} is not a tag")
         if tag == ARRAY:
             self.expect("(")
-            length = self.integer(self.next()[1])
+            length, length_tag = self.length(self.next()[1])
             element = self.head(self.next()[1], depth + 1)
             self.expect(")")
             if element.tag in (SUPPRESS, INDIRECT):
                 raise self.error("array elements must be data")
-            return TagHead(tag, length, element)
+            return TagHead(tag, length, element, length_tag)
         if tag in LENGTH_TAGS:
             self.expect("(")
-            length = self.integer(self.next()[1])
+            length, length_tag = self.length(self.next()[1])
             self.expect(")")
-            return TagHead(tag, length)
+            return TagHead(tag, length, length_tag=length_tag)
         return TagHead(tag)
+
+    def length(self, word: str) -> tuple[int, int | None]:
+        """A length in a head: ``200`` (the smallest form) or typed, ``I4:200`` (§6.2)."""
+        num = self.number(word)
+        if not num.is_integer or num.value < 0:
+            raise self.error(f"{word!r} is not a length")
+        return num.value, length_tag_of(num.tag, num.value)
 
     def integer(self, word: str) -> int:
         if not INTEGER.match(word):
@@ -240,6 +261,8 @@ class Assembler:
         element = self.head(self.next()[1])
         if element.tag in (SUPPRESS, INDIRECT):
             raise self.error("array elements must be data")
+        if written(element):
+            raise self.error("a longer length form in an element head goes in the =Ar(…) head")
         data = []
         while self.peek() and self.peek()[1] != "]":
             kind, word, _ = self.next()
@@ -304,7 +327,14 @@ def format_code(code: Code) -> str:
         return row.mnemonic if row else format_user_code(code.value)
     if code.kind is CodeKind.INDIRECT:
         return "@" + format_user_code(code.value)
-    return format_value(code.value)
+    if code.kind is CodeKind.SUPPRESSED and code.head is not None:
+        return "#" + format_head(code.head)
+    return written_prefix(code) + format_value(code.value)
+
+
+def written_prefix(code: Code) -> str:
+    """``=head `` before a datum whose head was written with a longer length form."""
+    return f"={format_head(code.head)} " if code.head is not None else ""
 
 
 def disassemble_codes(codes: list[Code], indent: int = 0, offsets: bool = False) -> list[str]:
@@ -314,7 +344,7 @@ def disassemble_codes(codes: list[Code], indent: int = 0, offsets: bool = False)
     for code in codes:
         note = f"  ; @{code.offset}" if offsets else ""
         if code.kind is CodeKind.DATA and isinstance(code.value, Function):
-            lines.append(pad + "Fn{" + note)
+            lines.append(pad + written_prefix(code) + "Fn{" + note)
             lines.extend(disassemble_codes(decode_function(code.value), indent + 1, offsets))
             lines.append(pad + "}")
         else:

@@ -8,10 +8,10 @@ from __future__ import annotations
 import math
 import struct
 
-from .codes import (ARRAY, FIXED_SIZE, FUNCTION, INDIRECT, INT_FORMAT, INT_RANGE,
-                    INTEGER_TAGS, LENGTH_TAGS, NUMERIC_TAGS, POSE, R4, R8, REAL_FORMAT, RECORD,
-                    STRING, SUPPRESS, TAG_NAMES, TRANSFORM, VECTOR, Array, Function,
-                    FunctionCode, Num, Pose, Record, Str, TagHead, Trn, UserCode, Vec)
+from .codes import (ARRAY, FIXED_SIZE, FUNCTION, I1, INDIRECT, INT_FORMAT, INTEGER_TAGS,
+                    LENGTH_TAGS, NUMERIC_TAGS, POSE, R4, R8, REAL_FORMAT, RECORD, STRING,
+                    SUPPRESS, TAG_NAMES, TRANSFORM, VECTOR, Array, Function, FunctionCode, Num,
+                    Pose, Record, Str, TagHead, Trn, UserCode, Vec, smallest_int)
 from .errors import ExceptionKind as K, fail
 
 
@@ -22,12 +22,24 @@ def invalid(detail: str, offset: int | None = None) -> Exception:
 
 
 # ---- lengths and numbers ------------------------------------------------------------------------
-def encode_length(length: int) -> bytes:
-    """§6.2: a length is a tagged integer, the 1-byte form up to 127; the smallest form is used."""
-    for tag in INTEGER_TAGS:
-        if INT_RANGE[tag][0] <= length <= INT_RANGE[tag][1]:
-            return bytes([tag]) + struct.pack(INT_FORMAT[tag], length)
-    raise fail(K.NUMERIC_OVERFLOW, f"length {length} does not fit I4")
+def encode_length(length: int, tag: int | None = None) -> bytes:
+    """§6.2: a length is a tagged integer; written in the smallest form unless ``tag`` (a
+    head's ``length_tag``) names the longer one it was read in."""
+    tag = tag or smallest_int(length).tag
+    return bytes([tag]) + struct.pack(INT_FORMAT[tag], length)
+
+
+def length_tag_of(tag: int, length: int, offset: int | None = None) -> int | None:
+    """The ``length_tag`` of a length written with the integer tag ``tag``: None for its
+    smallest form, ``tag`` for the other form §6.2 allows ("127以下の値ならタグ付きの1バイトの
+    整数を用い,それ以上なら2バイト又は4バイトの整数を用いる": an I4 for 128–32767); a length of
+    127 or less in I2 or I4 is invalid code."""
+    smallest = smallest_int(length).tag
+    if tag == smallest:
+        return None
+    if smallest == I1:
+        raise invalid(f"length {length} must be an I1 (127 or less)", offset)
+    return tag
 
 
 def encode_number_data(num: Num) -> bytes:
@@ -80,8 +92,8 @@ class Reader:
             raise invalid(f"0x{tag:02X} is not a numeric tag", start)
         return decode_number_data(tag, self.take(FIXED_SIZE[tag]), start)
 
-    def length(self) -> int:
-        """A length: any integer tag, non-negative, in its smallest form (so bytes round-trip)."""
+    def length(self) -> tuple[int, int | None]:
+        """A length, non-negative, in a form §6.2 allows: the value and its ``length_tag``."""
         start = self.offset
         tag = self.byte()
         if tag not in INTEGER_TAGS:
@@ -89,9 +101,7 @@ class Reader:
         value = decode_number_data(tag, self.take(FIXED_SIZE[tag])).value
         if value < 0:
             raise invalid(f"negative length {value}", start)
-        if encode_length(value)[0] != tag:
-            raise invalid(f"length {value} not in its smallest integer form", start)
-        return value
+        return value, length_tag_of(tag, value, start)
 
     def head(self, first: int, depth: int = 0) -> TagHead:
         """The data-tag-part after its first byte ``first`` (§6.1)."""
@@ -104,14 +114,15 @@ class Reader:
         if tag in FIXED_SIZE or tag in (SUPPRESS, INDIRECT):
             return TagHead(tag)
         if tag == ARRAY:
-            length = self.length()
+            length, length_tag = self.length()
             element_first = self.byte()
             element = self.head(element_first, depth + 1)
             if element.tag in (SUPPRESS, INDIRECT):
                 raise invalid("array elements must be data", start)
-            return TagHead(tag, length, element)
+            return TagHead(tag, length, element, length_tag)
         if tag in LENGTH_TAGS:
-            return TagHead(tag, self.length())
+            length, length_tag = self.length()
+            return TagHead(tag, length, length_tag=length_tag)
         raise invalid(f"reserved or undefined tag 0x{tag:X}", start)
 
 
@@ -119,9 +130,9 @@ class Reader:
 def encode_head(head: TagHead) -> bytes:
     tag = head.tag.to_bytes(2 if head.tag > 0xFF else 1, "big")
     if head.tag == ARRAY:
-        return tag + encode_length(head.length) + encode_head(head.element)
+        return tag + encode_length(head.length, head.length_tag) + encode_head(head.element)
     if head.tag in LENGTH_TAGS:
-        return tag + encode_length(head.length)
+        return tag + encode_length(head.length, head.length_tag)
     return tag
 
 

@@ -22,6 +22,7 @@ IRQ = ("#x 0 STORE #g Fn{ 1 DIN 1 AND END } STORE #h Fn{ #x x INC STORE 9 ESIG E
        "5 1 #g ACTCODE 5 #h ACTION")
 TICK = "#h Fn{ #x x INC STORE 9 ESIG END } STORE"    # a timer action
 PAUSE = "2 1 1 5 IOWAIT DROP DROP"                   # 5 ms on an input that stays off
+LONG_ST = '=St(I4:130) "' + "s" * 130 + '"'          # a string whose length is written as I4
 
 
 class Warns(list):
@@ -99,7 +100,8 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
     "NOT": [("0 NOT", [T]), ("2.5 NOT", [F]), ("0.0 NOT", [T]), ('"a" NOT', TYPE)],
     # ---- strings ---------------------------------------------------------------------------------
     "CONC": [('"ab" "cd" CONC', ['"abcd"']), ('"" "" CONC', ['""']), ('"ab" 1 CONC', TYPE)],
-    "LNG": [('"abc" LNG', ["3"]), ('"" LNG', ["0"]), ("1 LNG", TYPE)],
+    "LNG": [('"abc" LNG', ["3"]), ('"" LNG', ["0"]), ("1 LNG", TYPE),
+            (f'{LONG_ST} LNG', ["130"])],                # §6.2: a 4-byte length is read too
     "MID": [('"ABCDEFGH" 3 3 MID', ['"CDE"']), ('"ABC" 0 2 MID', ['"AB"']),
             ('"ABC" 2 0 MID', ['""']), ('"ABC" 2 10 MID', ['"BC"']), ('"ABC" 5 1 MID', ['""']),
             ('"ABC" 1.6 1 MID', ['"B"']), ("1 1 1 MID", TYPE)],
@@ -211,7 +213,8 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
              ('#x "AB" STORE #x 1 #I2 EXTB', AREA), ('#x "AB" STORE #x -1 #I1 EXTB', AREA),
              ("#x 0 #I1 EXTB", AREA), ('#x "AB" STORE #x 0 1 EXTB', TYPE),
              ("2 #I2 #x ALLOC DROP #x 1 #I1 EXTB", ["0"]),   # offsets count in the data part:
-             ("2 #I2 #x ALLOC DROP #x 1 #I2 EXTB", AREA)],   # the tag byte adds no room
+             ("2 #I2 #x ALLOC DROP #x 1 #I2 EXTB", AREA),    # the tag byte adds no room
+             (f"#x {LONG_ST} STORE #x 0 #St(I4:130) EXTB LNG", ["130"])],
     "EMBB": [('#x "ABCD" STORE #x 1 "zz" EMBB x', ['"AzzD"']),
              ("#x I2:0 STORE #x 1 5 EMBB x", ["I2:5"]),
              ('#x "AB" STORE #x 1 "zz" EMBB', AREA), ('#x "AB" STORE #x -1 "z" EMBB', AREA),

@@ -11,8 +11,10 @@ from strolic.codec import Code, CodeKind, decode, encode
 from strolic.codes import (I1, I2, I4, R4, R8, Array, Function, FunctionCode, Num, Pose, Record,
                            Str, TagHead, Trn, UserCode, Vec)
 from strolic.errors import ExceptionKind as K, StrolicError
+from strolic.literals import format_head, format_value
 from strolic.text import assemble, disassemble
 from strolic.values import encode_length, encode_value
+from strolic.vm import VM
 
 FUZZ = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
@@ -63,7 +65,8 @@ def test_function_codes_user_codes_and_indirect_references() -> None:
     ("F3", "reserved tag"), ("F8", "reserved tag"), ("FC", "reserved tag"), ("FE", "Mc reserved"),
     ("FF03", "reserved extended tag"), ("FF80", "user extension without format"),
     ("F2 00", "truncated integer"), ("FA F1 05 41", "string shorter than its length"),
-    ("FA F2 00 05 4141414141", "length not in smallest form"), ("FA F1 FF", "negative length"),
+    ("FA F2 00 05 4141414141", "127 or less is an I1"), ("FA F1 FF", "negative length"),
+    ("FA F4 00000005 4141414141", "127 or less is an I1"), ("FA F2 FF38", "negative length"),
     ("FA F5 00000000", "length must be an integer"), ("FD F1 02 F1 01", "no END"),
     ("FD F1 02 EF 00", "function data must end with END"), ("F7 EF 00", "indirect to a function"),
     ("F7 F1", "indirect without a user code"), ("F5 7F C0 00 00", "NaN"), ("F6 7FF0000000000000", "inf"),
@@ -75,6 +78,59 @@ def test_invalid_codes_are_reported(text: str, reason: str) -> None:
         decode(bytes.fromhex(text.replace(" ", "")))
     assert caught.value.kind is K.INVALID_CODE, reason
     assert caught.value.offset is not None
+
+
+def hexed(text: str) -> bytes:
+    return bytes.fromhex(text.replace(" ", ""))
+
+
+# §6.2: a length above 127 is a 2- or 4-byte integer; both are read, the smallest is written
+LONG_FORMS = [
+    ("FA F4 000000C8" + " 78" * 200, Str(b"x" * 200), TagHead(0xFA, 200, length_tag=I4)),
+    ("FB F4 00000080" + " 01" * 128, Record(b"\x01" * 128), TagHead(0xFB, 128, length_tag=I4)),
+    ("FF04 F4 00000082" + " F5 3F800000" * 26, Pose((Num(R4, 1.0),) * 26),
+     TagHead(0xFF04, 130, length_tag=I4)),
+    ("F9 F4 00000100 F2" + " 0007" * 128, Array(TagHead(I2), bytes.fromhex("0007") * 128),
+     TagHead(0xF9, 256, TagHead(I2), I4)),
+    ("F9 F2 0190 FA F4 000000C8" + " 61" * 400, Array(TagHead(0xFA, 200), b"a" * 400),
+     TagHead(0xF9, 400, TagHead(0xFA, 200, length_tag=I4))),
+    ("FD F4 00000082" + " F101" * 64 + " EF5C", Function(hexed("F101" * 64 + "EF5C")),
+     TagHead(0xFD, 130, length_tag=I4)),
+]
+
+
+@pytest.mark.parametrize("text, value, head", LONG_FORMS)
+def test_lengths_above_127_may_be_4_byte_integers(text: str, value, head: TagHead) -> None:
+    """Decoded as the same value, re-encoded as read (Code.head), and as the value in the
+    smallest form; the text form spells the longer form as a typed length."""
+    data = hexed(text)
+    (code,) = decode(data)
+    assert (code.kind, code.value, code.head, code.size) == (CodeKind.DATA, value, head, len(data))
+    assert encode([code]) == data
+    assert encode_value(value) != data and decode(encode_value(value))[0].value == value
+    assert disassemble(data).startswith(f"={format_head(head)} ")
+    assert assemble(disassemble(data)) == data
+
+
+@pytest.mark.parametrize("text, head", [
+    ("F0 FA F4 000000C8", TagHead(0xFA, 200, length_tag=I4)),
+    ("F0 F9 F4 00000190 FA F4 000000C8",
+     TagHead(0xF9, 400, TagHead(0xFA, 200, length_tag=I4), I4)),
+    ("F0 FA F4 00008000", None),                   # 32768 needs the I4: its smallest form
+])
+def test_suppressed_tags_keep_their_length_form(text: str, head) -> None:
+    data = hexed(text)
+    (code,) = decode(data)
+    assert code.head == head and code.value == (head or code.value).canonical()
+    assert encode([code]) == data and assemble(disassemble(data)) == data
+
+
+def test_a_long_length_form_inside_a_function_keeps_its_branch_offsets() -> None:
+    """Branch offsets count bytes: a round trip through the text must keep the datum's size."""
+    program = assemble(f'Fn{{ >skip BRA =St(I4:130) "{"s" * 130}" skip: 7 END }} VAR #%1000 DCL '
+                       "#%1000 EXCH STORE %1000")
+    assert assemble(disassemble(program)) == program
+    assert [format_value(v) for v in VM().run(program).stack] == ["7"]
 
 
 def test_error_offsets_point_into_nested_function_bodies() -> None:
@@ -109,7 +165,8 @@ def test_assembler_labels_compute_branch_offsets() -> None:
 @pytest.mark.parametrize("text", [
     "FOO", "%0FFF", "%EC00", "I3:5", "I1:300", "Vec(1 2)", "Ar[I2 1.5]", "Ar[St(2) \"abc\"]",
     "Fn{ 1 ", ">nowhere BRA", "Fn{ a: >a }", ".name ADD %1000", "\"\\q\"", "#Ar(2)", "<01>",
-    "R4:1e39", "Fn{ 1 }",
+    "R4:1e39", "Fn{ 1 }", "#St(I2:5)", "#St(I4:127)", "#St(-1)", "#St(1.5)", "=St(3) 5",
+    '=St(3) "ab"', "=I2", "=St(I4:200) #St(200)", 'Ar[St(I4:200) "x"]',
 ])
 def test_assembler_rejects_bad_text(text: str) -> None:
     with pytest.raises(StrolicError):
@@ -147,9 +204,20 @@ def data_values(codes):
         codes.map(lambda body: Function(encode(body + [Code(CodeKind.CALL, 0xEF5C, 0, 0)]))))
 
 
+def long_forms():
+    """Data and #tags whose lengths (128…300) are written as I4 (§6.2), kept in Code.head."""
+    return st.integers(128, 300).flatmap(lambda n: st.sampled_from([
+        Code(CodeKind.DATA, Str(b"w" * n), 0, 0, TagHead(0xFA, n, length_tag=I4)),
+        Code(CodeKind.DATA, Record(bytes(n)), 0, 0, TagHead(0xFB, n, length_tag=I4)),
+        Code(CodeKind.SUPPRESSED, TagHead(0xFA, n), 0, 0, TagHead(0xFA, n, length_tag=I4)),
+        Code(CodeKind.SUPPRESSED, TagHead(0xF9, 2 * n, TagHead(I2)), 0, 0,
+             TagHead(0xF9, 2 * n, TagHead(I2), I4))]))
+
+
 def program_codes():
     def extend(children):
         return st.lists(st.one_of(
+            long_forms(),
             data_values(children).map(lambda v: Code(CodeKind.DATA, v, 0, 0)),
             st.sampled_from(FUNCTION_CODES).map(lambda c: Code(CodeKind.CALL, c, 0, 0)),
             user_codes.map(lambda c: Code(CodeKind.CALL, c, 0, 0)),
@@ -167,7 +235,9 @@ def test_generated_programs_round_trip_through_bytes_and_text(codes) -> None:
     program = encode(codes)
     decoded = decode(program)
     assert encode(decoded) == program
-    assert [(c.kind, c.value) for c in decoded] == [(c.kind, c.value) for c in codes]
+    def parts(some: list[Code]) -> list[tuple]:
+        return [(c.kind, c.value, c.head) for c in some]
+    assert parts(decoded) == parts(codes)
     assert assemble(disassemble(program)) == program
 
 

@@ -81,6 +81,12 @@ def test_sync_and_result_write_the_output_stream() -> None:
                               bytes.fromhex("FF013F8000004000000040400000")]
 
 
+def test_a_datum_read_with_a_4_byte_length_is_written_in_the_smallest_form() -> None:
+    """§6.2: both forms are read; what the machine writes (RESULT) uses the smallest."""
+    vm, _ = execute('=St(I4:200) "' + "z" * 200 + '" RESULT')
+    assert vm.host.output == [bytes.fromhex("FAF200C8") + b"z" * 200]
+
+
 def test_robot_functions_go_to_the_host() -> None:
     error = error_of("1 JSPEED")
     assert (error.kind, error.function) == (K.UNDEFINED_DATA, "JSPEED")
