@@ -34,7 +34,9 @@ def _promoted(proc: Process, pop=pop_num) -> tuple[int, int | float, int | float
     """a b: the stronger representation of the two and both values converted to it (§5)."""
     a, b = _pop_pair(proc, pop)
     tag = max(a.tag, b.tag)
-    return tag, converted(a, tag), converted(b, tag)
+    if tag == R4:              # the one conversion that can round: an I4 to single precision
+        return tag, converted(a, tag), converted(b, tag)
+    return tag, a.value, b.value   # exact: Python's int/float arithmetic converts the same way
 
 
 def _checked_real(tag: int, value: float, *operands: float) -> Num:
@@ -82,7 +84,7 @@ def pwr(vm: VM, proc: Process) -> None:
             raise fail(K.NUMERIC_OVERFLOW, "PWR result too large")
         proc.push(make_int(tag, a ** b))
         return
-    if a < 0 and not b.is_integer():
+    if a < 0 and not float(b).is_integer():
         raise fail(K.UNDEFINED_DATA, "negative base with a fractional exponent")
     try:
         value = math.pow(a, b)
