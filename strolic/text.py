@@ -144,11 +144,13 @@ class Assembler:
     def written_datum(self, head: TagHead) -> Code:
         """``=St(I4:200) "…"``: the datum that follows, written with ``head`` (its lengths in
         the forms given)."""
+        if written(head) is None:
+            raise self.error(f"={format_head(head)} has no length in a longer form: leave it out")
         kind, word, line = self.next()
         code = self.code(kind, word, line)
         if code.kind is not CodeKind.DATA or head_of(code.value) != head.canonical():
             raise AsmError(f"the head ={format_head(head)} does not describe {word!r}", line)
-        return Code(CodeKind.DATA, code.value, 0, 0, written(head))
+        return Code(CodeKind.DATA, code.value, 0, 0, head)
 
     def user_code(self, word: str) -> int:
         if word in self.names:

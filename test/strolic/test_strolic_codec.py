@@ -166,7 +166,8 @@ def test_assembler_labels_compute_branch_offsets() -> None:
     "FOO", "%0FFF", "%EC00", "I3:5", "I1:300", "Vec(1 2)", "Ar[I2 1.5]", "Ar[St(2) \"abc\"]",
     "Fn{ 1 ", ">nowhere BRA", "Fn{ a: >a }", ".name ADD %1000", "\"\\q\"", "#Ar(2)", "<01>",
     "R4:1e39", "Fn{ 1 }", "#St(I2:5)", "#St(I4:127)", "#St(-1)", "#St(1.5)", "=St(3) 5",
-    '=St(3) "ab"', "=I2", "=St(I4:200) #St(200)", 'Ar[St(I4:200) "x"]',
+    '=St(3) "ab"', "=I2", "=St(I4:200) #St(200)", 'Ar[St(I4:200) "x"]', '=St(3) "abc"',
+    "=I1 5",
 ])
 def test_assembler_rejects_bad_text(text: str) -> None:
     with pytest.raises(StrolicError):
