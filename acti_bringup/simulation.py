@@ -21,7 +21,7 @@ SWITCH_INTERVAL_S = 2e-4
 
 @dataclass
 class SimulationConfig:
-    rate_hz: float = 240.0
+    rate_hz: float = 250.0
     real_time_factor: float = 1.0
     joint_state_rate_hz: float = 50.0
 

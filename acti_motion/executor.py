@@ -90,8 +90,14 @@ class Device:
     def submit(self, plan: Callable[[Any], Motion], label: str) -> int | None:
         """Plan a motion from the end of the last queued one and append it; its id, or None when
         the queue is full. Planning runs on the caller's thread, never under the lock that pause,
-        stop and the simulation take; a stop that comes in meanwhile makes it plan again from the
-        new end. Exceptions of `plan` (a refusal) pass through and queue nothing.
+        stop and the simulation take. Exceptions of `plan` (a refusal) pass through and queue
+        nothing.
+
+        A stop discards every command accumulated until the device is at rest (ACT 5.4.19;
+        the vehicle's 停止後は全ての動作指令を廃棄): a motion that arrives while a stop decelerates,
+        or whose planning a stop (or halt) overtook, is accepted (it gets an id) and discarded
+        when the device comes to rest, or at once when it already rests; `was_discarded(id)`
+        says so, and nothing of it runs.
         """
         with self._accept:
             while True:
@@ -101,20 +107,25 @@ class Device:
                     generation, start = self.generation, self.queued_end
                 motion = plan(start)
                 with self.lock:
-                    if generation != self.generation:
-                        continue
                     if len(self.queue) >= self.capacity:
                         return None
+                    if generation != self.generation:
+                        if self.current is None and not self.queue:
+                            return self._accept_discarded()
+                        if self._stop_at is None:
+                            continue        # a halt's own motion runs: plan again from its end
                     self.last_id += 1
                     self.queue.append(QueuedMotion(self.last_id, motion, label))
-                    self.queued_end = self._end_of_queue()
+                    if self._stop_at is None:
+                        self.queued_end = self._end_of_queue()
                     self.changed.notify_all()
                     return self.last_id
 
     def pause(self, ramp: float) -> bool:
-        """Decelerate over `ramp` seconds and hold; the queue stays. False when already paused."""
+        """Decelerate over `ramp` seconds and hold (also what is queued and not yet started);
+        the queue stays. False when already paused or stopping (a stop clears a pause)."""
         with self.lock:
-            if self.paused:
+            if self.paused or self._stop_at is not None:
                 return False
             self.paused = True
             self._set_rate(0.0, ramp)
@@ -133,7 +144,9 @@ class Device:
         """Discard the queue, clear a pause and decelerate the current motion over `ramp` seconds.
 
         The rate falls linearly, so the motion's clock advances rate² · ramp / 2 more seconds: the
-        rest point is known now and becomes the start of whatever is queued next.
+        rest point is known now and becomes the start of whatever is queued next. A stop while
+        one decelerates keeps the shorter ramp and computes the rest point again from the rate
+        now, so the clock never jumps to a rest point meant for another ramp.
         """
         with self.lock:
             self._discard_pending()
@@ -144,8 +157,9 @@ class Device:
                 if self._stop_at is None:
                     # a move cut short to hand over to the next (a blend) stops along its whole path
                     cur.motion = getattr(cur.motion, "unblended", cur.motion)
-                    self._stop_at = min(cur.motion.duration,
-                                        self.t + self.rate * self.rate * ramp / 2)
+                else:
+                    ramp = min(ramp, self._ramp)
+                self._stop_at = min(cur.motion.duration, self.t + self.rate * self.rate * ramp / 2)
                 self._set_rate(0.0, ramp)
             self.queued_end = self._end_of_queue()
 
@@ -215,6 +229,8 @@ class Device:
                 self.t = self._stop_at
                 cur.motion.apply(world, self.t, 0.0)
                 self._finish(discarded=True)
+                self._retire_queue()            # what came in while it decelerated
+                self.queued_end = self.hold
                 return
             end = self.t >= cur.motion.duration
             cur.motion.apply(world, min(self.t, cur.motion.duration), 0.0 if end else r1)
@@ -249,6 +265,15 @@ class Device:
         if last is self.current and self._stop_at is not None:
             return last.motion.at(self._stop_at)
         return last.motion.at(last.motion.duration)
+
+    def _accept_discarded(self) -> int:
+        """A new id, retired at once as discarded (a stop overtook it)."""
+        self.last_id += 1
+        self.discarded += 1
+        self._discarded_ids.append((self.last_id, self.last_id))
+        self.retired_id = max(self.retired_id, self.last_id)
+        self.changed.notify_all()
+        return self.last_id
 
     def _discard_pending(self) -> None:
         """Drop the queue and a pause; motions planned meanwhile plan again (new generation)."""
