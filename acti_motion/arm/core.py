@@ -64,6 +64,7 @@ SPEED_ROTATION_DEG_S = (0.1, 3600.0)
 SOFT_LIMIT_CARTESIAN_MM = 100000.0       # |limit|: a box of 200 m holds every reachable point
 BASE_OFFSET_MM = 100000.0                # |translation| of set_base_offset
 CONTROL_POINT_OFFSET_MM = 2000.0         # |translation| of set_control_point_offset
+TARGET_MM = 1000000.0                    # |x|, |y|, |z| of a Cartesian target or Rel step
 ELBOW_DEG = 360.0                        # |elbow| of a Cartesian target (Abs) or turn (Rel)
 REACH_SAMPLES = 64                       # points of a CP path checked against the reach first
 MAX_CHECK_SAMPLES = 20000                # points of a CP path checked against the soft limits
@@ -111,10 +112,10 @@ def shared_kinematics() -> ArmKinematics:
 def _offset(offset: list[float], bound_mm: float, code: ReturnCode) -> np.ndarray:
     """The pose of an offset HgMatrix whose translation is within `bound_mm`, else `code`."""
     pose = hg_to_pose(offset, "offset", code=code)
-    shift = float(np.linalg.norm(pose[:3, 3])) * 1000.0
+    shift = float(np.max(np.abs(pose[:3, 3]))) * 1000.0
     if shift > bound_mm:
-        raise Refused(code, f"offset: the translation is {shift:.6g} mm long: it must be at "
-                            f"most {bound_mm:g} mm")
+        raise Refused(code, f"offset: a translation of {shift:.6g} mm: each axis must be within "
+                            f"±{bound_mm:g} mm")
     return pose
 
 
@@ -668,6 +669,10 @@ class ArmCore:
             car_point = (car_point.get("car_pos"), car_point.get("elbow"),
                          car_point.get("struct_flag", 0))
         pose = hg_to_pose(car_point[0], f"{name}.car_pos")
+        far = float(np.max(np.abs(pose[:3, 3]))) * 1000.0
+        if far > TARGET_MM:
+            raise value_error(f"{name}.car_pos: a translation of {far:.6g} mm is out of any reach "
+                              f"(at most ±{TARGET_MM:g} mm per axis)")
         elbow = _in_range(car_point[1], -ELBOW_DEG, ELBOW_DEG, f"{name}.elbow", "°")
         return pose, math.radians(elbow)
 
