@@ -95,7 +95,7 @@ def test_nested_messages_both_ways(ros, arm_node):
     bad = list(new)
     bad[2] = LimitValue(upper=-10.0, lower=10.0)
     r = call(ros, "set_soft_limit_joint", srv.SetSoftLimitJoint, soft_limit=bad)
-    assert r.return_id.id == -3 and "below lower" in r.return_id.comment
+    assert r.return_id.id == -3 and "above lower" in r.return_id.comment
     speed = call(ros, "get_max_speed_cartesian", srv.GetMaxSpeedCartesian).speed
     assert (speed.translation, speed.rotation) == (500.0, 90.0)
     pos = call(ros, "get_feedback_pos_cartesian", srv.GetFeedbackPosCartesian).pos

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 import threading
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import IntEnum
 from functools import lru_cache
 from typing import Any, Callable
@@ -86,21 +86,39 @@ class Alarm:
         return (self.code, int(self.type), self.description)
 
 
+def _ranged(default: Any, lo: float, hi: float) -> Any:
+    """A config field with a range (the parameter's descriptor shows it)."""
+    return field(default=default, metadata={"range": (lo, hi)})
+
+
 @dataclass
 class ArmConfig:
-    """Start-up settings of the arm (the node's parameters); units as on the services."""
+    """Start-up settings of the arm (the node's parameters); units as on the services. The
+    comment of each field is its parameter's description."""
+    # motion queue capacity (FULL_MOTION_QUEUE_ERR beyond)
     queue_size: int = 32
-    initial_speed_ratio: int = 0                  # % for both setSpeedJoint and setSpeedCartesian
-    accel_time_joint: float = 0.3                 # s
-    min_accel_time_joint: float = 0.1             # s
-    accel_time_cartesian: float = 0.3             # s
-    min_accel_time_cartesian: float = 0.1         # s
-    max_speed_translation: float = 500.0          # mm/s
-    max_speed_rotation: float = 90.0              # degree/s (orientation and elbow)
-    gripper_speed: float = 100.0                  # mm/s of the opening (both fingers)
-    # x lower, x upper, y lower, y upper, z lower, z upper of the control point [mm]
+    # joint and Cartesian speed ratio at start-up [%] (the spec says 0)
+    initial_speed_ratio: int = _ranged(0, 0, 100)
+    # PTP accel/decel time [s] (set_accel_time_joint)
+    accel_time_joint: float = _ranged(0.3, 0.0, MAX_ACCEL_TIME_S)
+    # minimum joint accel time [s]: joint accel limit = max speed / it (set_min_accel_time_joint)
+    min_accel_time_joint: float = _ranged(0.1, 0.0, MAX_ACCEL_TIME_S)
+    # CP accel/decel time [s] (set_accel_time_cartesian)
+    accel_time_cartesian: float = _ranged(0.3, 0.0, MAX_ACCEL_TIME_S)
+    # minimum CP accel time [s] (set_min_accel_time_cartesian)
+    min_accel_time_cartesian: float = _ranged(0.1, 0.0, MAX_ACCEL_TIME_S)
+    # maximum CP speed [mm/s] (set_max_speed_cartesian)
+    max_speed_translation: float = _ranged(500.0, *SPEED_TRANSLATION_MM_S)
+    # maximum CP rotation and elbow speed [degree/s] (set_max_speed_cartesian)
+    max_speed_rotation: float = _ranged(90.0, *SPEED_ROTATION_DEG_S)
+    # gripper opening speed, both fingers [mm/s]
+    gripper_speed: float = 100.0
+    # Cartesian soft limits of the control point, robot frame [mm]: x lower, x upper, y lower,
+    # y upper, z lower, z upper (set_soft_limit_cartesian)
     soft_limit_cartesian: tuple[float, ...] = (-1000.0, 1200.0, -1000.0, 1000.0, -100.0, 1600.0)
+    # J1 … J7 at start-up [degree]
     initial_joints_deg: tuple[float, ...] = (0.0, 30.0, 0.0, -60.0, 0.0, 60.0, 0.0)
+    # go_home target J1 … J7 [degree] (set_home)
     home_joints_deg: tuple[float, ...] = (0.0, 30.0, 0.0, -60.0, 0.0, 60.0, 0.0)
 
 
@@ -145,9 +163,6 @@ def _check_config(c: ArmConfig) -> None:
         raise ValueError(f"gripper_speed must be finite and > 0, got {c.gripper_speed}")
     if c.queue_size < 1 or not 0 <= c.initial_speed_ratio <= 100:
         raise ValueError("queue_size must be >= 1 and initial_speed_ratio within 0 … 100 %")
-    if len(c.soft_limit_cartesian) != 6:
-        raise ValueError("soft_limit_cartesian needs x lower, x upper, y lower, y upper, "
-                         f"z lower, z upper, got {c.soft_limit_cartesian}")
 
 
 def _in_range(x: float, lo: float, hi: float, name: str, unit: str) -> float:
@@ -199,7 +214,6 @@ class ArmCore:
     def _apply_settings(self, c: ArmConfig) -> None:
         """The start-up settings that a service also sets, through that service's validation
         (the node's parameters of the same names use it too); ValueError names the one refused."""
-        lo, hi = c.soft_limit_cartesian[0::2], c.soft_limit_cartesian[1::2]
         for name, reply in (
                 ("min_accel_time_joint", self.set_min_accel_time_joint(c.min_accel_time_joint)),
                 ("accel_time_joint", self.set_accel_time_joint(c.accel_time_joint)),
@@ -208,7 +222,7 @@ class ArmCore:
                 ("accel_time_cartesian", self.set_accel_time_cartesian(c.accel_time_cartesian)),
                 ("max_speed_translation/max_speed_rotation", self.set_max_speed_cartesian(
                     (c.max_speed_translation, c.max_speed_rotation))),
-                ("soft_limit_cartesian", self.set_soft_limit_cartesian(*zip(hi, lo)))):
+                ("soft_limit_cartesian", self.set_soft_limit_box(c.soft_limit_cartesian))):
             if not reply.ok:
                 raise ValueError(f"{name}: {reply.comment}")
 
@@ -427,6 +441,19 @@ class ArmCore:
                                   f"within ±{SOFT_LIMIT_CARTESIAN_MM:g} mm")
             limits[i] = lower, upper
         self.soft_limit_cartesian = limits
+
+    @returns(*SETTER)
+    def set_soft_limit_box(self, box: tuple[float, ...]) -> Reply:
+        """set_soft_limit_cartesian with the limits in the config's order: x lower, x upper,
+        y lower, y upper, z lower, z upper (the parameter soft_limit_cartesian)."""
+        if len(box) != 6:
+            raise value_error("soft_limit_cartesian needs x lower, x upper, y lower, y upper, "
+                              f"z lower, z upper: 6 values, got {len(box)}")
+        return self.set_soft_limit_cartesian(*((box[i + 1], box[i]) for i in (0, 2, 4)))
+
+    def soft_limit_box(self) -> tuple[float, ...]:
+        """The Cartesian soft limits in the config's order (see set_soft_limit_box)."""
+        return tuple(float(x) for x in self.soft_limit_cartesian.reshape(-1))
 
     @returns(*SETTER)
     def set_base_offset(self, offset: list[float]) -> None:
