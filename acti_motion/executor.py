@@ -233,6 +233,14 @@ class Device:
                 self.queued_end = self.hold
                 return
             end = self.t >= cur.motion.duration
+            if end and hasattr(cur.motion, "unblended") and self.queue:
+                # cut to hand over at speed (a blend): the next motion goes on in this same step,
+                # from the time past the seam, also while a pause decelerates (no halt there)
+                past = self.t - cur.motion.duration
+                self._finish(discarded=False)
+                cur = self.current = self.queue.popleft()
+                self.t = past
+                end = self.t >= cur.motion.duration
             cur.motion.apply(world, min(self.t, cur.motion.duration), 0.0 if end else r1)
             if end:
                 self._finish(discarded=False)

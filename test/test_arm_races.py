@@ -6,11 +6,12 @@ import threading
 import numpy as np
 import pytest
 
-from acti_motion.arm.core import ArmConfig, ArmCore
+from acti_motion.arm.blending import blend_with_previous
+from acti_motion.arm.core import ArmCore
 from acti_motion.executor import MotionExecutor
 from acti_motion.replies import ReturnCode as R
 from acti_sim.world import World
-from arm_fixtures import IDENTITY, WORK, arm  # noqa: F401
+from arm_fixtures import IDENTITY, arm  # noqa: F401
 from sim_fixtures import executor, run_until  # noqa: F401
 from trajectory_check import ArmTrace
 
@@ -233,3 +234,21 @@ def test_cmd_cycle_is_the_control_period(rate_hz, comment):
         assert (comment in r.comment) and (bool(r.comment) == bool(comment))
     finally:
         world.close()
+
+
+@pytest.mark.parametrize("before_seam", [0.2, 0.1, 0.05, 0.0])
+def test_pause_near_a_blend_seam_decelerates_along_the_next_move(arm, executor, trace,
+                                                                  before_seam):  # noqa: F811
+    """Was: a move cut to blend into the next (STROLIC SACC) ended at speed while a pause
+    decelerated, and the set-point halted at the seam (up to 7× the acceleration limit)."""
+    a = arm.move_ptp_joint_rel([20.0] * 7).values["motion_id"]
+    b = arm.move_ptp_joint_rel([0.0, 20.0, 0.0, 0.0, 0.0, 0.0, 0.0]).values["motion_id"]
+    assert blend_with_previous(arm.device, b, a, 0.05, lambda q: arm.tool_pose(q)[:3, 3]) > 0.1
+    seam = arm.device.queue[0].motion.duration
+    run_until(executor, lambda: executor.world.time >= seam - before_seam, 5.0)
+    assert arm.pause().ok
+    run_until(executor, lambda: not arm.state_word() & MOVING, 2.0)
+    assert arm.resume().ok
+    rest(executor, arm)
+    assert arm.device.completed == 2
+    trace.check()
