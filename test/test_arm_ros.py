@@ -6,7 +6,7 @@ import time
 import pytest
 from acti_msgs import srv
 from acti_msgs.action import Move, WaitMotion
-from acti_msgs.msg import ArmState, CarPosWithElbow, LimitValue
+from acti_msgs.msg import ArmState, CarPosWithElbow, CartesianSpeed, LimitValue
 from action_msgs.msg import GoalStatus
 from rclpy.action import ActionClient
 
@@ -113,6 +113,24 @@ def test_nested_messages_both_ways(ros, arm_node):
     ("set_control_point_offset", srv.SetControlPointOffset, dict(offset=[2.0] + IDENTITY[1:]), -1),
     ("set_accel_time_joint", srv.SetAccelTimeJoint, dict(acl_time=math.inf), -3),
     ("set_speed_cartesian", srv.SetSpeedCartesian, dict(spd_ratio=101), -3),
+    # absurd numbers: refused with a comment, no traceback in the node's log (the fixture checks)
+    ("set_accel_time_joint", srv.SetAccelTimeJoint, dict(acl_time=1e308), -3),
+    ("set_accel_time_cartesian", srv.SetAccelTimeCartesian, dict(acl_time=5e-324), -3),
+    ("set_min_accel_time_joint", srv.SetMinAccelTimeJoint, dict(acl_time=1e308), -3),
+    ("set_min_accel_time_cartesian", srv.SetMinAccelTimeCartesian, dict(acl_time=math.nan), -3),
+    ("set_max_speed_joint", srv.SetMaxSpeedJoint, dict(speed=[5e-324] * 7), -3),
+    ("set_max_speed_cartesian", srv.SetMaxSpeedCartesian,
+     dict(speed=CartesianSpeed(translation=1e308, rotation=90.0)), -3),
+    ("set_soft_limit_cartesian", srv.SetSoftLimitCartesian, dict(), -3),        # all zero
+    ("move_ptp_joint_abs", srv.MovePTPJointAbs, dict(joint_points=[1e308] * 7), -3),
+    ("move_linear_cartesian_rel", srv.MoveLinearCartesianRel, dict(car_point=rel(dx=math.inf)),
+     -3),
+    ("move_ptp_cartesian_abs", srv.MovePTPCartesianAbs,
+     dict(car_point=CarPosWithElbow(car_pos=IDENTITY[:3] + [1e308] + IDENTITY[4:])), -3),
+    ("move_circular_cartesian_rel", srv.MoveCircularCartesianRel,
+     dict(car_point_r=rel(dx=1e6), car_point_t=rel(dz=-50.0)), -3),
+    ("move_linear_cartesian_abs", srv.MoveLinearCartesianAbs,
+     dict(car_point=CarPosWithElbow(car_pos=IDENTITY, elbow=-math.inf)), -3),
 ])
 def test_bad_inputs_answer_the_right_id_and_the_node_stays_up(ros, arm_node, name, srv_type,
                                                                fields, code):
