@@ -7,6 +7,7 @@ simulation thread ramps linearly, so every motion decelerates along its own path
 """
 from __future__ import annotations
 
+import logging
 import threading
 import time
 from collections import deque
@@ -14,6 +15,8 @@ from dataclasses import dataclass
 from typing import Any, Callable, Protocol
 
 from acti_sim.world import World
+
+_log = logging.getLogger("acti_motion")
 
 
 class Motion(Protocol):
@@ -219,33 +222,53 @@ class Device:
                 self.current = self.queue.popleft()
                 self.t = 0.0
                 self.changed.notify_all()
-            r0 = self.rate
-            step = dt / self._ramp if self._ramp > 0 else 1.0
-            r1 = min(self._rate_target, r0 + step) if r0 < self._rate_target else max(self._rate_target, r0 - step)
-            self.rate = r1
-            self.t += dt * (r0 + r1) / 2
-            cur = self.current
-            if self._stop_at is not None and (r1 <= 0.0 or self.t >= self._stop_at):
-                self.t = self._stop_at
-                cur.motion.apply(world, self.t, 0.0)
-                self._finish(discarded=True)
-                self._retire_queue()            # what came in while it decelerated
-                self.queued_end = self.hold
-                return
+            t0 = self.t
+            try:
+                self._advance(world, dt)
+            except Exception as e:
+                self._fail(e, t0)
+
+    def _advance(self, world: World, dt: float) -> None:
+        """One step of the current motion: ramp the rate, advance its clock, command the world."""
+        r0 = self.rate
+        step = dt / self._ramp if self._ramp > 0 else 1.0
+        r1 = min(self._rate_target, r0 + step) if r0 < self._rate_target else max(self._rate_target, r0 - step)
+        self.rate = r1
+        self.t += dt * (r0 + r1) / 2
+        cur = self.current
+        if self._stop_at is not None and (r1 <= 0.0 or self.t >= self._stop_at):
+            self.t = self._stop_at
+            cur.motion.apply(world, self.t, 0.0)
+            self._finish(discarded=True)
+            self._retire_queue()            # what came in while it decelerated
+            self.queued_end = self.hold
+            return
+        end = self.t >= cur.motion.duration
+        if end and hasattr(cur.motion, "unblended") and self.queue:
+            # cut to hand over at speed (a blend): the next motion goes on in this same step,
+            # from the time past the seam, also while a pause decelerates (no halt there)
+            past = self.t - cur.motion.duration
+            self._finish(discarded=False)
+            cur = self.current = self.queue.popleft()
+            self.t = past
             end = self.t >= cur.motion.duration
-            if end and hasattr(cur.motion, "unblended") and self.queue:
-                # cut to hand over at speed (a blend): the next motion goes on in this same step,
-                # from the time past the seam, also while a pause decelerates (no halt there)
-                past = self.t - cur.motion.duration
-                self._finish(discarded=False)
-                cur = self.current = self.queue.popleft()
-                self.t = past
-                end = self.t >= cur.motion.duration
-            cur.motion.apply(world, min(self.t, cur.motion.duration), 0.0 if end else r1)
-            if end:
-                self._finish(discarded=False)
+        cur.motion.apply(world, min(self.t, cur.motion.duration), 0.0 if end else r1)
+        if end:
+            self._finish(discarded=False)
 
     # --- internals (lock held) ---------------------------------------------------------------
+    def _fail(self, error: Exception, t0: float) -> None:
+        """A motion that fails while it runs (a bug, a plan no check foresaw) is discarded with
+        the queue where its last step put it; the simulation steps on and the process stays."""
+        cur = self.current
+        what = f"motion {cur.id} ({cur.label}) failed at {t0:.3f} s" if cur else "a step failed"
+        _log.error(f"{self.name}: {what}, discarded with the queue: {type(error).__name__}: {error}")
+        self._discard_pending()
+        if cur is not None:
+            self.t = t0
+            self._finish(discarded=True)
+        self.queued_end = self.hold
+
     def _set_rate(self, target: float, ramp: float) -> None:
         self._rate_target = target
         self._ramp = max(ramp, 1e-6)

@@ -252,3 +252,35 @@ def test_pause_near_a_blend_seam_decelerates_along_the_next_move(arm, executor, 
     rest(executor, arm)
     assert arm.device.completed == 2
     trace.check()
+
+
+class FailsAfter:
+    """Fault injection: a real planned arm motion whose set-points fail past `t_fail` (a bug
+    that no check foresaw)."""
+
+    def __init__(self, motion, t_fail: float) -> None:
+        self.motion, self.t_fail = motion, t_fail
+        self.duration, self.ramp, self.kind = motion.duration, motion.ramp, motion.kind
+
+    def at(self, t):
+        return self.motion.at(t)
+
+    def apply(self, world, t, rate):
+        if t > self.t_fail:
+            raise FloatingPointError("set-point is NaN")
+        self.motion.apply(world, t, rate)
+
+
+def test_a_motion_that_fails_while_running_is_discarded_and_the_simulation_goes_on(
+        arm, executor, trace, caplog):  # noqa: F811
+    """Was: an exception in a running motion ended the simulation thread (the whole main job)."""
+    assert arm.move_ptp_joint_rel([10.0] * 7).ok
+    planned = arm.device.queue.pop().motion
+    broken = arm.device.submit(lambda start: FailsAfter(planned, 0.2), "broken")
+    assert arm.move_ptp_joint_rel([5.0] * 7).ok
+    run_until(executor, lambda: not arm.device.busy, 2.0)                 # steps on, no raise
+    assert arm.device.was_discarded(broken) and arm.device.discarded == 2
+    assert "FloatingPointError: set-point is NaN" in caplog.text
+    assert arm.move_ptp_joint_rel([-5.0] * 7).ok                          # and moves again
+    rest(executor, arm)
+    assert arm.device.completed == 1
