@@ -464,10 +464,10 @@ class ArmCore:
     def set_control_point_offset(self, offset: list[float]) -> None:
         """Refused while anything runs, is paused mid-move or is queued: those targets were
         planned with the present control point (5.4.23: not while moving)."""
-        self._check_idle("set_control_point_offset")
         if self.device.busy:
             raise Refused(R.STATUS_ERR, "set_control_point_offset is refused while a motion is "
                                         "running, paused or queued (wait or stop first)")
+        self._check_idle("set_control_point_offset")
         tool = _offset(offset, CONTROL_POINT_OFFSET_MM, ReturnCode.NG)
         self.frames = Frames(self.frames.base, tool)
 
