@@ -228,3 +228,26 @@ def test_pause_resume_and_queue_full_over_dds(ros, arm_node, wait_motion):
     status, result = wait_motion.result(wait_motion.send(motion_id=0))
     assert status == GoalStatus.STATUS_SUCCEEDED and result.completed
     assert result.motion_id == ids[-1]
+
+
+def test_pause_right_after_accept_and_a_move_during_stop_over_dds(ros, arm_node, wait_motion):
+    """The spec races over DDS: a pause answered right after a move was accepted holds it (was:
+    "ignored: the arm is not moving"); a move sent while a stop decelerates is discarded."""
+    ready(ros)
+    first = call(ros, "move_ptp_joint_rel", srv.MovePTPJointRel, joint_points=[5.0] * 7)
+    r = call(ros, "pause", srv.Pause)
+    assert r.return_id.id == 0 and not r.return_id.comment
+    assert call(ros, "get_state", srv.GetState).state & 0x10
+    assert call(ros, "resume", srv.Resume).return_id.id == 0
+    status, result = wait_motion.result(wait_motion.send(motion_id=first.motion_id))
+    assert result.completed
+    call(ros, "set_speed_joint", srv.SetSpeedJoint, spd_ratio=20)
+    call(ros, "set_accel_time_joint", srv.SetAccelTimeJoint, acl_time=5.0)   # a long stop
+    call(ros, "move_ptp_joint_rel", srv.MovePTPJointRel, joint_points=[-5.0] * 7)
+    assert wait_until(lambda: call(ros, "get_state", srv.GetState).state & 0x02, 10.0)
+    assert call(ros, "stop", srv.Stop).return_id.id == 0
+    late = call(ros, "move_ptp_joint_rel", srv.MovePTPJointRel, joint_points=[1.0] * 7)
+    assert late.return_id.id == 0
+    status, result = wait_motion.result(wait_motion.send(motion_id=late.motion_id))
+    assert status == GoalStatus.STATUS_SUCCEEDED and not result.completed
+    call(ros, "set_accel_time_joint", srv.SetAccelTimeJoint, acl_time=0.3)
