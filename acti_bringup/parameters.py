@@ -138,16 +138,12 @@ def _descriptor(f: dataclasses.Field, value: Any, note: str, settable: bool) -> 
     if not settable:
         description += " (read-only: set at start-up)"
     d = ParameterDescriptor(name=f.name, description=description.strip(), read_only=not settable)
-    bounds = f.metadata.get("range")
-    if bounds is not None:
-        lo, hi = bounds
-        if isinstance(value, bool):
-            pass
-        elif isinstance(value, int):
-            d.integer_range = [IntegerRange(from_value=int(lo), to_value=int(hi), step=0)]
-        elif isinstance(value, float):
-            d.floating_point_range = [FloatingPointRange(from_value=float(lo), to_value=float(hi),
-                                                         step=0.0)]
+    lo, hi = f.metadata.get("range", (None, None))
+    if isinstance(value, float) and lo is not None:
+        d.floating_point_range = [FloatingPointRange(from_value=float(lo), to_value=float(hi),
+                                                     step=0.0)]
+    elif isinstance(value, int) and not isinstance(value, bool) and lo is not None:
+        d.integer_range = [IntegerRange(from_value=int(lo), to_value=int(hi), step=0)]
     return d
 
 

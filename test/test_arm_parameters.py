@@ -2,12 +2,15 @@
 effect through the matching service's validation (seen by its getter) and refuse a bad value with
 the service's reason, read-only ones refuse every set; a change through a service shows in the
 parameter. vehicle_node's parameters are all read-only (none is settable yet)."""
+from dataclasses import dataclass, field
+
 import pytest
 from acti_msgs import srv
 from acti_msgs.msg import CartesianSpeed, LimitValue
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import DescribeParameters, GetParameters, ListParameters, SetParameters
 
+from acti_bringup.parameters import field_descriptions
 from ros_harness import node_fixture, wait_until
 
 arm_node = node_fixture("acti_middle_node", "queue_size:=4")
@@ -43,6 +46,24 @@ def described(ros, node):
              if n not in ROS_OWN]
     return {d.name: d for d in ros.call(DescribeParameters, node + "describe_parameters",
                                         names=names).descriptors}
+
+
+@dataclass
+class Example:
+    trailing: float = 1.0          # a trailing comment [s]
+    # a comment above,
+    # on two lines
+    above: int = 2
+    given: str = field(default="", metadata={"description": "from metadata"})  # not this
+    bare: float = 3.0
+    after_trailing: float = 4.0
+
+
+def test_descriptions_come_from_the_field_comments():
+    d = field_descriptions(Example)
+    assert d["trailing"] == "a trailing comment [s]"
+    assert d["above"] == "a comment above, on two lines"
+    assert d["bare"] == "" and d["after_trailing"] == ""     # no comment of its own
 
 
 def test_every_parameter_has_a_description_and_says_whether_it_can_be_set(ros, arm_node):
