@@ -143,6 +143,14 @@ def test_every_move_refuses_absurd_numbers_at_once_and_keeps_the_queue(arm, x):
         assert [m.id for m in arm.device.queue] == [1]
 
 
+def test_every_move_takes_5e_324_as_the_tiny_number_it_is(arm):
+    """Denormal inputs: a move to where it is (or through a denormal via point) is queued or
+    refused with VALUE_ERR and a comment, never an internal failure."""
+    for op, kwargs in move_calls(TINY):
+        r = getattr(arm, op)(**kwargs)
+        assert r.code in (R.OK, R.VALUE_ERR) and (r.ok or r.comment), (op, kwargs, r)
+
+
 @pytest.mark.parametrize("via_mm", [1e6, 5000.0])
 def test_a_far_via_point_is_refused_before_planning(arm, via_mm):
     """Was: a circular move through a via point 1 km away took 5-17 s to be refused."""
