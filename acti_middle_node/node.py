@@ -3,7 +3,7 @@ the ~/wait_motion, ~/move and ~/run_program (STROLIC) actions, and the ~/state t
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable
 
 import pinocchio as pin
 from acti_msgs.msg import Alarm, ArmState, ReturnId
@@ -11,7 +11,7 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
 from acti_bringup.adapter import serve_operations
-from acti_bringup.parameters import declare_config
+from acti_bringup.parameters import Setting, declare_config, sync_parameters
 from acti_bringup.simulation import Simulation
 from acti_middle_node.actions import ActionConfig, MotionActions
 from acti_middle_node.operations import OPERATIONS
@@ -26,6 +26,23 @@ class TopicConfig:
     state_rate_hz: float = 20.0      # ~/state publication rate [Hz]
 
 
+# The parameters that take effect at run time: how each is set (through the service that sets
+# it, so a bad value is refused as the service refuses it) and read (the value in force).
+ARM_SETTINGS: dict[str, tuple[Callable[[ArmCore, Any], Reply], Callable[[ArmCore], Any]]] = {
+    "accel_time_joint": (ArmCore.set_accel_time_joint, lambda c: c.accel_time_joint),
+    "min_accel_time_joint": (ArmCore.set_min_accel_time_joint, lambda c: c.min_accel_time_joint),
+    "accel_time_cartesian": (ArmCore.set_accel_time_cartesian, lambda c: c.accel_time_cartesian),
+    "min_accel_time_cartesian": (ArmCore.set_min_accel_time_cartesian,
+                                 lambda c: c.min_accel_time_cartesian),
+    "max_speed_translation": (lambda c, v: c.set_max_speed_cartesian((v, c.max_speed_cartesian[1])),
+                              lambda c: c.max_speed_cartesian[0]),
+    "max_speed_rotation": (lambda c, v: c.set_max_speed_cartesian((c.max_speed_cartesian[0], v)),
+                           lambda c: c.max_speed_cartesian[1]),
+    "soft_limit_cartesian": (ArmCore.set_soft_limit_box, ArmCore.soft_limit_box),
+    "home_joints_deg": (lambda c, v: c.set_home(list(v)), lambda c: tuple(c.home)),
+}
+
+
 def write_return_id(response: Any, reply: Reply) -> None:
     response.return_id = ReturnId(id=int(reply.code), comment=reply.comment)
 
@@ -36,7 +53,10 @@ class ArmNode(Node):
     def __init__(self, simulation: Simulation | None = None) -> None:
         super().__init__("acti_middle_node")
         self.simulation = simulation or Simulation(self)
-        self.core = ArmCore(self.simulation.executor, declare_config(self, ArmConfig))
+        settings = {name: Setting(apply=lambda v, f=f: f(self.core, v),
+                                  read=lambda g=g: g(self.core))
+                    for name, (f, g) in ARM_SETTINGS.items()}
+        self.core = ArmCore(self.simulation.executor, declare_config(self, ArmConfig, settings))
         serve_operations(self, self.core, OPERATIONS, write_return_id)
         group = ReentrantCallbackGroup()
         actions = declare_config(self, ActionConfig)
@@ -50,6 +70,7 @@ class ArmNode(Node):
         self.create_timer(1.0 / topics.state_rate_hz, self._publish_state, callback_group=group)
 
     def _publish_state(self) -> None:
+        sync_parameters(self)             # settings changed through the services, as parameters
         core = self.core
         q = core.feedback_joints
         pose = core.tool_pose(q)

@@ -7,6 +7,7 @@ simulation thread ramps linearly, so every motion decelerates along its own path
 """
 from __future__ import annotations
 
+import logging
 import threading
 import time
 from collections import deque
@@ -14,6 +15,8 @@ from dataclasses import dataclass
 from typing import Any, Callable, Protocol
 
 from acti_sim.world import World
+
+_log = logging.getLogger("acti_motion")
 
 
 class Motion(Protocol):
@@ -90,8 +93,14 @@ class Device:
     def submit(self, plan: Callable[[Any], Motion], label: str) -> int | None:
         """Plan a motion from the end of the last queued one and append it; its id, or None when
         the queue is full. Planning runs on the caller's thread, never under the lock that pause,
-        stop and the simulation take; a stop that comes in meanwhile makes it plan again from the
-        new end. Exceptions of `plan` (a refusal) pass through and queue nothing.
+        stop and the simulation take. Exceptions of `plan` (a refusal) pass through and queue
+        nothing.
+
+        A stop discards every command accumulated until the device is at rest (ACT 5.4.19;
+        the vehicle's 停止後は全ての動作指令を廃棄): a motion that arrives while a stop decelerates,
+        or whose planning a stop (or halt) overtook, is accepted (it gets an id) and discarded
+        when the device comes to rest, or at once when it already rests; `was_discarded(id)`
+        says so, and nothing of it runs.
         """
         with self._accept:
             while True:
@@ -101,20 +110,25 @@ class Device:
                     generation, start = self.generation, self.queued_end
                 motion = plan(start)
                 with self.lock:
-                    if generation != self.generation:
-                        continue
                     if len(self.queue) >= self.capacity:
                         return None
+                    if generation != self.generation:
+                        if self.current is None and not self.queue:
+                            return self._accept_discarded()
+                        if self._stop_at is None:
+                            continue        # a halt's own motion runs: plan again from its end
                     self.last_id += 1
                     self.queue.append(QueuedMotion(self.last_id, motion, label))
-                    self.queued_end = self._end_of_queue()
+                    if self._stop_at is None:
+                        self.queued_end = self._end_of_queue()
                     self.changed.notify_all()
                     return self.last_id
 
     def pause(self, ramp: float) -> bool:
-        """Decelerate over `ramp` seconds and hold; the queue stays. False when already paused."""
+        """Decelerate over `ramp` seconds and hold (also what is queued and not yet started);
+        the queue stays. False when already paused or stopping (a stop clears a pause)."""
         with self.lock:
-            if self.paused:
+            if self.paused or self._stop_at is not None:
                 return False
             self.paused = True
             self._set_rate(0.0, ramp)
@@ -133,7 +147,9 @@ class Device:
         """Discard the queue, clear a pause and decelerate the current motion over `ramp` seconds.
 
         The rate falls linearly, so the motion's clock advances rate² · ramp / 2 more seconds: the
-        rest point is known now and becomes the start of whatever is queued next.
+        rest point is known now and becomes the start of whatever is queued next. A stop while
+        one decelerates keeps the shorter ramp and computes the rest point again from the rate
+        now, so the clock never jumps to a rest point meant for another ramp.
         """
         with self.lock:
             self._discard_pending()
@@ -144,8 +160,9 @@ class Device:
                 if self._stop_at is None:
                     # a move cut short to hand over to the next (a blend) stops along its whole path
                     cur.motion = getattr(cur.motion, "unblended", cur.motion)
-                    self._stop_at = min(cur.motion.duration,
-                                        self.t + self.rate * self.rate * ramp / 2)
+                else:
+                    ramp = min(ramp, self._ramp)
+                self._stop_at = min(cur.motion.duration, self.t + self.rate * self.rate * ramp / 2)
                 self._set_rate(0.0, ramp)
             self.queued_end = self._end_of_queue()
 
@@ -205,23 +222,53 @@ class Device:
                 self.current = self.queue.popleft()
                 self.t = 0.0
                 self.changed.notify_all()
-            r0 = self.rate
-            step = dt / self._ramp if self._ramp > 0 else 1.0
-            r1 = min(self._rate_target, r0 + step) if r0 < self._rate_target else max(self._rate_target, r0 - step)
-            self.rate = r1
-            self.t += dt * (r0 + r1) / 2
-            cur = self.current
-            if self._stop_at is not None and (r1 <= 0.0 or self.t >= self._stop_at):
-                self.t = self._stop_at
-                cur.motion.apply(world, self.t, 0.0)
-                self._finish(discarded=True)
-                return
+            t0 = self.t
+            try:
+                self._advance(world, dt)
+            except Exception as e:
+                self._fail(e, t0)
+
+    def _advance(self, world: World, dt: float) -> None:
+        """One step of the current motion: ramp the rate, advance its clock, command the world."""
+        r0 = self.rate
+        step = dt / self._ramp if self._ramp > 0 else 1.0
+        r1 = min(self._rate_target, r0 + step) if r0 < self._rate_target else max(self._rate_target, r0 - step)
+        self.rate = r1
+        self.t += dt * (r0 + r1) / 2
+        cur = self.current
+        if self._stop_at is not None and (r1 <= 0.0 or self.t >= self._stop_at):
+            self.t = self._stop_at
+            cur.motion.apply(world, self.t, 0.0)
+            self._finish(discarded=True)
+            self._retire_queue()            # what came in while it decelerated
+            self.queued_end = self.hold
+            return
+        end = self.t >= cur.motion.duration
+        if end and hasattr(cur.motion, "unblended") and self.queue:
+            # cut to hand over at speed (a blend): the next motion goes on in this same step,
+            # from the time past the seam, also while a pause decelerates (no halt there)
+            past = self.t - cur.motion.duration
+            self._finish(discarded=False)
+            cur = self.current = self.queue.popleft()
+            self.t = past
             end = self.t >= cur.motion.duration
-            cur.motion.apply(world, min(self.t, cur.motion.duration), 0.0 if end else r1)
-            if end:
-                self._finish(discarded=False)
+        cur.motion.apply(world, min(self.t, cur.motion.duration), 0.0 if end else r1)
+        if end:
+            self._finish(discarded=False)
 
     # --- internals (lock held) ---------------------------------------------------------------
+    def _fail(self, error: Exception, t0: float) -> None:
+        """A motion that fails while it runs (a bug, a plan no check foresaw) is discarded with
+        the queue where its last step put it; the simulation steps on and the process stays."""
+        cur = self.current
+        what = f"motion {cur.id} ({cur.label}) failed at {t0:.3f} s" if cur else "a step failed"
+        _log.error(f"{self.name}: {what}, discarded with the queue: {type(error).__name__}: {error}")
+        self._discard_pending()
+        if cur is not None:
+            self.t = t0
+            self._finish(discarded=True)
+        self.queued_end = self.hold
+
     def _set_rate(self, target: float, ramp: float) -> None:
         self._rate_target = target
         self._ramp = max(ramp, 1e-6)
@@ -249,6 +296,15 @@ class Device:
         if last is self.current and self._stop_at is not None:
             return last.motion.at(self._stop_at)
         return last.motion.at(last.motion.duration)
+
+    def _accept_discarded(self) -> int:
+        """A new id, retired at once as discarded (a stop overtook it)."""
+        self.last_id += 1
+        self.discarded += 1
+        self._discarded_ids.append((self.last_id, self.last_id))
+        self.retired_id = max(self.retired_id, self.last_id)
+        self.changed.notify_all()
+        return self.last_id
 
     def _discard_pending(self) -> None:
         """Drop the queue and a pause; motions planned meanwhile plan again (new generation)."""

@@ -6,12 +6,16 @@ so every check reads as one line and every refusal carries a comment for a perso
 from __future__ import annotations
 
 import functools
+import logging
 import math
 from dataclasses import dataclass, field
 from enum import IntEnum
 from typing import Any, Callable, Iterable
 
 import numpy as np
+
+
+_log = logging.getLogger("acti_motion")
 
 
 class ReturnCode(IntEnum):
@@ -47,13 +51,19 @@ class Reply:
 
 
 def answers(fn: Callable[..., dict[str, Any] | Reply | None]) -> Callable[..., Reply]:
-    """Wrap a core operation: its out-values dict becomes an OK reply, `Refused` a refusal."""
+    """Wrap a core operation: its out-values dict becomes an OK reply, `Refused` a refusal, and
+    any other exception (a bug, or input no check foresaw) NG with a comment that says what
+    failed: a request never ends the process and never leaves a traceback in the log."""
     @functools.wraps(fn)
     def wrapper(*args: Any, **kwargs: Any) -> Reply:
         try:
             out = fn(*args, **kwargs)
         except Refused as r:
             return Reply(r.code, r.comment)
+        except Exception as e:
+            comment = f"{fn.__name__} failed: {type(e).__name__}: {e}"
+            _log.error(comment)
+            return Reply(ReturnCode.NG, comment)
         if isinstance(out, Reply):
             return out
         return Reply(values=out or {})

@@ -12,6 +12,7 @@ from acti_motion.arm.poses import hg_to_pose, orientation_error_deg, position_er
 from acti_motion.replies import ReturnCode as R
 from acti_motion.arm.trajectories import ConstAccelTiming, Trapezoid
 from sim_fixtures import executor, run_until  # noqa: F401
+from trajectory_check import ArmTrace
 
 IDENTITY = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
 WORK = [0.0, 45.0, 0.0, -90.0, 0.0, 45.0, 0.0]      # wrist above the shoulder, flange up
@@ -183,6 +184,7 @@ def speed(executor):  # noqa: F811
 
 
 def test_pause_decelerates_holds_keeps_the_queue_and_resume_finishes(arm, executor):  # noqa: F811
+    trace = ArmTrace(executor, arm)
     goal = np.add(WORK, [30.0, -20.0, 20.0, 30.0, 20.0, 20.0, 40.0])
     assert arm.move_ptp_joint_abs(list(goal)).ok and arm.move_ptp_joint_rel([-5.0] * 7).ok
     run_until(executor, lambda: executor.world.time > 0.8, 2.0)
@@ -202,10 +204,13 @@ def test_pause_decelerates_holds_keeps_the_queue_and_resume_finishes(arm, execut
     pos = arm.get_feedback_pos_joint().values["pos"][:7]
     assert np.max(np.abs(np.subtract(pos, goal - 4.0))) < 0.01
     assert arm.device.completed == 3 and arm.state_word() == 0x01
+    trace.check()
+    trace.check_rest(np.radians(goal - 4.0))
 
 
 @pytest.mark.parametrize("kind", ["ptp", "linear"])
 def test_stop_decelerates_within_the_accel_time_and_flushes(arm, executor, kind):  # noqa: F811
+    trace = ArmTrace(executor, arm)
     if kind == "ptp":
         assert arm.move_ptp_joint_rel([40.0, -20.0, 30.0, 20.0, 30.0, 20.0, 40.0]).ok
         ramp = arm.accel_time_joint
@@ -217,33 +222,43 @@ def test_stop_decelerates_within_the_accel_time_and_flushes(arm, executor, kind)
     run_until(executor, lambda: executor.world.time > 0.7, 2.0)
     assert speed(executor) > 0.1
     assert arm.stop().ok
+    rest_at = arm.device.queued_end.joints.copy()
     assert arm.device.queue_length == 0 and arm.state_word() & 0x08 == 0
     took = run_until(executor, lambda: not arm.device.busy, 2.0)
     assert took <= ramp + 0.01
     assert all(arm.device.was_discarded(i) for i in range(first, first + 3))
     for _ in range(60):
         executor.step()
+    trace.check_rest(rest_at)
     assert speed(executor) < 1e-2
     here = arm.get_feedback_pos_joint().values["pos"][:7]
     assert arm.move_ptp_joint_rel([2.0] * 7).ok                  # continues from the rest point
     rest(executor, arm)
     assert np.max(np.abs(np.subtract(arm.get_feedback_pos_joint().values["pos"][:7],
                                      np.add(here, 2.0)))) < 0.02
+    trace.check()
 
 
 def test_stop_while_paused_flushes_and_clears_the_pause(arm, executor):  # noqa: F811
+    trace = ArmTrace(executor, arm)
     assert arm.move_ptp_joint_rel([20.0] * 7).ok and arm.move_ptp_joint_rel([5.0] * 7).ok
     run_until(executor, lambda: executor.world.time > 0.5, 2.0)
     assert arm.pause().ok
     run_until(executor, lambda: not arm.state_word() & 0x02, 2.0)
+    held = trace.last.copy()
     assert arm.stop().ok
     assert arm.state_word() & 0x10 == 0 and arm.device.queue_length == 0
     assert run_until(executor, lambda: not arm.device.busy, 0.1) < 0.02
     assert arm.resume().comment == "ignored: the arm is not paused"
     assert arm.state_word() == 0x01
+    for _ in range(10):
+        executor.step()
+    trace.check()
+    trace.check_rest(held)                       # rests where the pause held it
 
 
 def test_pause_while_stopping_is_ignored(arm, executor):  # noqa: F811
+    trace = ArmTrace(executor, arm)
     assert arm.move_ptp_joint_rel([20.0] * 7).ok
     run_until(executor, lambda: executor.world.time > 0.5, 2.0)
     assert arm.stop().ok
@@ -252,6 +267,7 @@ def test_pause_while_stopping_is_ignored(arm, executor):  # noqa: F811
     assert arm.state_word() == 0x01
     assert arm.move_ptp_joint_rel([1.0] * 7).ok
     assert run_until(executor, lambda: not arm.device.busy, 2.0) > 0.2
+    trace.check()
 
 
 # --- gripper -------------------------------------------------------------------------------------------------
@@ -282,6 +298,7 @@ def test_gripper_commands_queue_in_order_with_the_moves(arm, executor):  # noqa:
 
 # --- soft limits watched while moving --------------------------------------------------------------------
 def test_cartesian_soft_limit_crossed_while_moving_stops_with_alarm_5(arm, executor):  # noqa: F811
+    trace = ArmTrace(executor, arm)
     P0, _ = feedback(arm)
     x0 = P0[0, 3] * 1000
     assert arm.move_linear_cartesian_rel(rel(dx=200.0)).ok and arm.move_ptp_joint_rel([1.0] * 7).ok
@@ -300,9 +317,11 @@ def test_cartesian_soft_limit_crossed_while_moving_stops_with_alarm_5(arm, execu
     assert arm.move_linear_cartesian_rel(rel(dx=-50.0)).ok        # back inside: allowed
     rest(executor, arm)
     assert not arm.alarms
+    trace.check()
 
 
 def test_joint_soft_limit_narrowed_while_paused_raises_alarm_4_on_resume(arm, executor):  # noqa: F811
+    trace = ArmTrace(executor, arm)
     assert arm.move_ptp_joint_rel([40.0, 0, 0, 0, 0, 0, 0]).ok
     run_until(executor, lambda: executor.world.time > 0.4, 2.0)
     assert arm.pause().ok
@@ -316,6 +335,7 @@ def test_joint_soft_limit_narrowed_while_paused_raises_alarm_4_on_resume(arm, ex
     assert arm.alarms[0].code == 0x4 and "J1" in arm.alarms[0].description
     run_until(executor, lambda: not arm.device.busy, 1.0)
     assert arm.get_active_alarm().values["alarms"][0][:2] == (0x4, 1)
+    trace.check()
 
 
 def test_elbow_turns_without_moving_the_control_point(arm, executor):  # noqa: F811

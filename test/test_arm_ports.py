@@ -84,7 +84,7 @@ def test_each_operation_answers_exactly_the_ids_the_spec_lists(arm, op):
 # --- getters -------------------------------------------------------------------------------------
 def test_getters_at_start(arm):
     info = arm.get_manip_info().values["manip_info"]
-    assert info[2:] == (7, 4, True) and info[0]
+    assert info[2:] == (7, 4, True) and info[0]       # 250 Hz: exactly 4 ms
     assert arm.get_active_alarm().values == {"alarms": []}
     limits = arm.get_soft_limit_joint().values["soft_limit"]
     assert len(limits) == 7 and all(u > lo for u, lo in limits)
@@ -132,7 +132,9 @@ def test_accel_times_and_their_minimums(arm, kind):
 
 @pytest.mark.parametrize("speed, words", [
     ([80.0] * 6, "7 values"), ([80.0] * 8, "7 values"), ([NAN] + [80.0] * 6, "finite"),
-    ([0.0] + [80.0] * 6, "> 0"), ([-5.0] + [80.0] * 6, "> 0"), ([200.0] + [80.0] * 6, "rated"),
+    ([0.0] + [80.0] * 6, "at least"), ([-5.0] + [80.0] * 6, "at least"),
+    ([200.0] + [80.0] * 6, "rated"), ([5e-324] * 7, "at least 0.1"), ([1e308] * 7, "rated"),
+    ([INF] * 7, "finite"),
 ])
 def test_max_speed_joint_refusals(arm, speed, words):
     r = arm.set_max_speed_joint(speed)
@@ -161,7 +163,8 @@ def test_soft_limit_cartesian(arm):
 
 @pytest.mark.parametrize("limits, words", [
     ([(90.0, -90.0)] * 6, "7 limits"), ([(90.0, -90.0)] * 8, "7 limits"),
-    ([(-90.0, 90.0)] + [(90.0, -90.0)] * 6, "below lower"),
+    ([(-90.0, 90.0)] + [(90.0, -90.0)] * 6, "above lower"),
+    ([(10.0, 10.0)] + [(90.0, -90.0)] * 6, "above lower"),
     ([(NAN, -90.0)] + [(90.0, -90.0)] * 6, "finite"),
     ([(90.0, -90.0)] * 6 + [(180.0, -90.0)], "hardware"),
 ])

@@ -6,7 +6,7 @@ import time
 import pytest
 from acti_msgs import srv
 from acti_msgs.action import Move, WaitMotion
-from acti_msgs.msg import ArmState, CarPosWithElbow, LimitValue
+from acti_msgs.msg import ArmState, CarPosWithElbow, CartesianSpeed, LimitValue
 from action_msgs.msg import GoalStatus
 from rclpy.action import ActionClient
 
@@ -95,7 +95,7 @@ def test_nested_messages_both_ways(ros, arm_node):
     bad = list(new)
     bad[2] = LimitValue(upper=-10.0, lower=10.0)
     r = call(ros, "set_soft_limit_joint", srv.SetSoftLimitJoint, soft_limit=bad)
-    assert r.return_id.id == -3 and "below lower" in r.return_id.comment
+    assert r.return_id.id == -3 and "above lower" in r.return_id.comment
     speed = call(ros, "get_max_speed_cartesian", srv.GetMaxSpeedCartesian).speed
     assert (speed.translation, speed.rotation) == (500.0, 90.0)
     pos = call(ros, "get_feedback_pos_cartesian", srv.GetFeedbackPosCartesian).pos
@@ -113,6 +113,24 @@ def test_nested_messages_both_ways(ros, arm_node):
     ("set_control_point_offset", srv.SetControlPointOffset, dict(offset=[2.0] + IDENTITY[1:]), -1),
     ("set_accel_time_joint", srv.SetAccelTimeJoint, dict(acl_time=math.inf), -3),
     ("set_speed_cartesian", srv.SetSpeedCartesian, dict(spd_ratio=101), -3),
+    # absurd numbers: refused with a comment, no traceback in the node's log (the fixture checks)
+    ("set_accel_time_joint", srv.SetAccelTimeJoint, dict(acl_time=1e308), -3),
+    ("set_accel_time_cartesian", srv.SetAccelTimeCartesian, dict(acl_time=5e-324), -3),
+    ("set_min_accel_time_joint", srv.SetMinAccelTimeJoint, dict(acl_time=1e308), -3),
+    ("set_min_accel_time_cartesian", srv.SetMinAccelTimeCartesian, dict(acl_time=math.nan), -3),
+    ("set_max_speed_joint", srv.SetMaxSpeedJoint, dict(speed=[5e-324] * 7), -3),
+    ("set_max_speed_cartesian", srv.SetMaxSpeedCartesian,
+     dict(speed=CartesianSpeed(translation=1e308, rotation=90.0)), -3),
+    ("set_soft_limit_cartesian", srv.SetSoftLimitCartesian, dict(), -3),        # all zero
+    ("move_ptp_joint_abs", srv.MovePTPJointAbs, dict(joint_points=[1e308] * 7), -3),
+    ("move_linear_cartesian_rel", srv.MoveLinearCartesianRel, dict(car_point=rel(dx=math.inf)),
+     -3),
+    ("move_ptp_cartesian_abs", srv.MovePTPCartesianAbs,
+     dict(car_point=CarPosWithElbow(car_pos=IDENTITY[:3] + [1e308] + IDENTITY[4:])), -3),
+    ("move_circular_cartesian_rel", srv.MoveCircularCartesianRel,
+     dict(car_point_r=rel(dx=1e6), car_point_t=rel(dz=-50.0)), -3),
+    ("move_linear_cartesian_abs", srv.MoveLinearCartesianAbs,
+     dict(car_point=CarPosWithElbow(car_pos=IDENTITY, elbow=-math.inf)), -3),
 ])
 def test_bad_inputs_answer_the_right_id_and_the_node_stays_up(ros, arm_node, name, srv_type,
                                                                fields, code):
@@ -210,3 +228,26 @@ def test_pause_resume_and_queue_full_over_dds(ros, arm_node, wait_motion):
     status, result = wait_motion.result(wait_motion.send(motion_id=0))
     assert status == GoalStatus.STATUS_SUCCEEDED and result.completed
     assert result.motion_id == ids[-1]
+
+
+def test_pause_right_after_accept_and_a_move_during_stop_over_dds(ros, arm_node, wait_motion):
+    """The spec races over DDS: a pause answered right after a move was accepted holds it (was:
+    "ignored: the arm is not moving"); a move sent while a stop decelerates is discarded."""
+    ready(ros)
+    first = call(ros, "move_ptp_joint_rel", srv.MovePTPJointRel, joint_points=[5.0] * 7)
+    r = call(ros, "pause", srv.Pause)
+    assert r.return_id.id == 0 and not r.return_id.comment
+    assert call(ros, "get_state", srv.GetState).state & 0x10
+    assert call(ros, "resume", srv.Resume).return_id.id == 0
+    status, result = wait_motion.result(wait_motion.send(motion_id=first.motion_id))
+    assert result.completed
+    call(ros, "set_speed_joint", srv.SetSpeedJoint, spd_ratio=20)
+    call(ros, "set_accel_time_joint", srv.SetAccelTimeJoint, acl_time=5.0)   # a long stop
+    call(ros, "move_ptp_joint_rel", srv.MovePTPJointRel, joint_points=[-5.0] * 7)
+    assert wait_until(lambda: call(ros, "get_state", srv.GetState).state & 0x02, 10.0)
+    assert call(ros, "stop", srv.Stop).return_id.id == 0
+    late = call(ros, "move_ptp_joint_rel", srv.MovePTPJointRel, joint_points=[1.0] * 7)
+    assert late.return_id.id == 0
+    status, result = wait_motion.result(wait_motion.send(motion_id=late.motion_id))
+    assert status == GoalStatus.STATUS_SUCCEEDED and not result.completed
+    call(ros, "set_accel_time_joint", srv.SetAccelTimeJoint, acl_time=0.3)

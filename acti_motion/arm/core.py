@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 import threading
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import IntEnum
 from functools import lru_cache
 from typing import Any, Callable
@@ -24,7 +24,7 @@ import numpy as np
 
 from acti_motion.executor import MotionExecutor
 from acti_motion.arm.kinematics import ArmKinematics, Unreachable, rotate_about
-from acti_motion.arm.poses import (Frames, compose_relative, hg_to_pose, pose_to_hg)
+from acti_motion.arm.poses import Frames, compose_relative, hg_to_pose, inverse, pose_to_hg
 from acti_motion.profiles import Trapezoid
 from acti_motion.replies import (Refused, Reply, ReturnCode, finite_number, finite_vector,
                                  ratio_percent, returns, value_error)
@@ -54,6 +54,21 @@ CARTESIAN_WATCH_TOLERANCE_MM = 0.1
 REL_ELBOW_CLEARANCE = math.sin(math.radians(10.0))
 JOINT_WATCH_TOLERANCE_DEG = 1e-6
 
+# Bounds of the settings that keep the arm stoppable and every plan quick (README: arm settings).
+# A stop decelerates over the running move's accel time, so an accel time of minutes is a
+# misconfiguration, not a setting; speeds below the minimums would time a move over days.
+MAX_ACCEL_TIME_S = 10.0
+MIN_SPEED_JOINT_DEG_S = 0.1
+SPEED_TRANSLATION_MM_S = (1.0, 10000.0)
+SPEED_ROTATION_DEG_S = (0.1, 3600.0)
+SOFT_LIMIT_CARTESIAN_MM = 100000.0       # |limit|: a box of 200 m holds every reachable point
+BASE_OFFSET_MM = 100000.0                # |translation| of set_base_offset
+CONTROL_POINT_OFFSET_MM = 2000.0         # |translation| of set_control_point_offset
+TARGET_MM = 1000000.0                    # |x|, |y|, |z| of a Cartesian target or Rel step
+ELBOW_DEG = 360.0                        # |elbow| of a Cartesian target (Abs) or turn (Rel)
+REACH_SAMPLES = 64                       # points of a CP path checked against the reach first
+MAX_CHECK_SAMPLES = 20000                # points of a CP path checked against the soft limits
+
 
 class AlarmType(IntEnum):
     FAULT = 0
@@ -71,27 +86,55 @@ class Alarm:
         return (self.code, int(self.type), self.description)
 
 
+def _ranged(default: Any, lo: float, hi: float) -> Any:
+    """A config field with a range (the parameter's descriptor shows it)."""
+    return field(default=default, metadata={"range": (lo, hi)})
+
+
 @dataclass
 class ArmConfig:
-    """Start-up settings of the arm (the node's parameters); units as on the services."""
+    """Start-up settings of the arm (the node's parameters); units as on the services. The
+    comment of each field is its parameter's description."""
+    # motion queue capacity (FULL_MOTION_QUEUE_ERR beyond)
     queue_size: int = 32
-    initial_speed_ratio: int = 0                  # % for both setSpeedJoint and setSpeedCartesian
-    accel_time_joint: float = 0.3                 # s
-    min_accel_time_joint: float = 0.1             # s
-    accel_time_cartesian: float = 0.3             # s
-    min_accel_time_cartesian: float = 0.1         # s
-    max_speed_translation: float = 500.0          # mm/s
-    max_speed_rotation: float = 90.0              # degree/s (orientation and elbow)
-    gripper_speed: float = 100.0                  # mm/s of the opening (both fingers)
-    # x lower, x upper, y lower, y upper, z lower, z upper of the control point [mm]
+    # joint and Cartesian speed ratio at start-up [%] (the spec says 0)
+    initial_speed_ratio: int = _ranged(0, 0, 100)
+    # PTP accel/decel time [s] (set_accel_time_joint)
+    accel_time_joint: float = _ranged(0.3, 0.0, MAX_ACCEL_TIME_S)
+    # minimum joint accel time [s]: joint accel limit = max speed / it (set_min_accel_time_joint)
+    min_accel_time_joint: float = _ranged(0.1, 0.0, MAX_ACCEL_TIME_S)
+    # CP accel/decel time [s] (set_accel_time_cartesian)
+    accel_time_cartesian: float = _ranged(0.3, 0.0, MAX_ACCEL_TIME_S)
+    # minimum CP accel time [s] (set_min_accel_time_cartesian)
+    min_accel_time_cartesian: float = _ranged(0.1, 0.0, MAX_ACCEL_TIME_S)
+    # maximum CP speed [mm/s] (set_max_speed_cartesian)
+    max_speed_translation: float = _ranged(500.0, *SPEED_TRANSLATION_MM_S)
+    # maximum CP rotation and elbow speed [degree/s] (set_max_speed_cartesian)
+    max_speed_rotation: float = _ranged(90.0, *SPEED_ROTATION_DEG_S)
+    # gripper opening speed, both fingers [mm/s]
+    gripper_speed: float = 100.0
+    # Cartesian soft limits of the control point, robot frame [mm]: x lower, x upper, y lower,
+    # y upper, z lower, z upper (set_soft_limit_cartesian)
     soft_limit_cartesian: tuple[float, ...] = (-1000.0, 1200.0, -1000.0, 1000.0, -100.0, 1600.0)
+    # J1 … J7 at start-up [degree]
     initial_joints_deg: tuple[float, ...] = (0.0, 30.0, 0.0, -60.0, 0.0, 60.0, 0.0)
+    # go_home target J1 … J7 [degree] (set_home)
     home_joints_deg: tuple[float, ...] = (0.0, 30.0, 0.0, -60.0, 0.0, 60.0, 0.0)
 
 
 @lru_cache(maxsize=1)
 def shared_kinematics() -> ArmKinematics:
     return ArmKinematics()
+
+
+def _offset(offset: list[float], bound_mm: float, code: ReturnCode) -> np.ndarray:
+    """The pose of an offset HgMatrix whose translation is within `bound_mm`, else `code`."""
+    pose = hg_to_pose(offset, "offset", code=code)
+    shift = float(np.max(np.abs(pose[:3, 3]))) * 1000.0
+    if shift > bound_mm:
+        raise Refused(code, f"offset: a translation of {shift:.6g} mm: each axis must be within "
+                            f"±{bound_mm:g} mm")
+    return pose
 
 
 def _ignored(why: str) -> Reply:
@@ -114,19 +157,20 @@ def _first_exit(values: np.ndarray, lower: np.ndarray, upper: np.ndarray,
 
 
 def _check_config(c: ArmConfig) -> None:
-    """The start-up settings, else ValueError (the node does not start) saying which."""
-    positive = ("accel_time_joint", "min_accel_time_joint", "accel_time_cartesian",
-                "min_accel_time_cartesian", "max_speed_translation", "max_speed_rotation",
-                "gripper_speed")
-    bad = [n for n in positive if not (math.isfinite(getattr(c, n)) and getattr(c, n) > 0)]
-    if bad:
-        raise ValueError(f"{', '.join(bad)} must be finite and > 0")
+    """The start-up settings that have no setter, else ValueError (the node does not start);
+    the others are applied through their setters (`ArmCore._apply_settings`)."""
+    if not (math.isfinite(c.gripper_speed) and c.gripper_speed > 0):
+        raise ValueError(f"gripper_speed must be finite and > 0, got {c.gripper_speed}")
     if c.queue_size < 1 or not 0 <= c.initial_speed_ratio <= 100:
         raise ValueError("queue_size must be >= 1 and initial_speed_ratio within 0 … 100 %")
-    box = np.asarray(c.soft_limit_cartesian, float)
-    if box.shape != (6,) or not np.all(np.isfinite(box)) or np.any(box[0::2] > box[1::2]):
-        raise ValueError("soft_limit_cartesian needs x lower, x upper, y lower, y upper, "
-                         f"z lower, z upper with lower <= upper, got {c.soft_limit_cartesian}")
+
+
+def _in_range(x: float, lo: float, hi: float, name: str, unit: str) -> float:
+    """x if finite and within [lo, hi], else VALUE_ERR that gives the bounds."""
+    x = finite_number(x, name)
+    if not lo <= x <= hi:
+        raise value_error(f"{name} is {x:g} {unit}: it must be within {lo:g} … {hi:g} {unit}")
+    return x
 
 
 class ArmCore:
@@ -150,15 +194,12 @@ class ArmCore:
         # settings (units of the ports)
         self.max_speed_joint = self.hard_max_speed_joint.copy()
         self.soft_limit_joint = self.hard_limit_joint.copy()          # rows: [lower, upper]
-        self.soft_limit_cartesian = np.array(c.soft_limit_cartesian, float).reshape(3, 2)
         self.speed_joint = ratio_percent(c.initial_speed_ratio, "initial_speed_ratio")
         self.speed_cartesian = self.speed_joint
-        self.min_accel_time_joint = c.min_accel_time_joint
-        self.accel_time_joint = max(c.accel_time_joint, c.min_accel_time_joint)
-        self.min_accel_time_cartesian = c.min_accel_time_cartesian
-        self.accel_time_cartesian = max(c.accel_time_cartesian, c.min_accel_time_cartesian)
-        self.max_speed_cartesian = (float(c.max_speed_translation), float(c.max_speed_rotation))
+        self.min_accel_time_joint = self.accel_time_joint = MAX_ACCEL_TIME_S
+        self.min_accel_time_cartesian = self.accel_time_cartesian = MAX_ACCEL_TIME_S
         self.frames = Frames()
+        self._apply_settings(c)
         self.servo = False
         self._alarms: list[Alarm] = []
         self._alarm_lock = threading.Lock()
@@ -169,6 +210,21 @@ class ArmCore:
         self._inside: np.ndarray | None = None
         executor.after_step(self._sample)
         threading.Thread(target=load_toppra, name="toppra-import", daemon=True).start()
+
+    def _apply_settings(self, c: ArmConfig) -> None:
+        """The start-up settings that a service also sets, through that service's validation
+        (the node's parameters of the same names use it too); ValueError names the one refused."""
+        for name, reply in (
+                ("min_accel_time_joint", self.set_min_accel_time_joint(c.min_accel_time_joint)),
+                ("accel_time_joint", self.set_accel_time_joint(c.accel_time_joint)),
+                ("min_accel_time_cartesian",
+                 self.set_min_accel_time_cartesian(c.min_accel_time_cartesian)),
+                ("accel_time_cartesian", self.set_accel_time_cartesian(c.accel_time_cartesian)),
+                ("max_speed_translation/max_speed_rotation", self.set_max_speed_cartesian(
+                    (c.max_speed_translation, c.max_speed_rotation))),
+                ("soft_limit_cartesian", self.set_soft_limit_box(c.soft_limit_cartesian))):
+            if not reply.ok:
+                raise ValueError(f"{name}: {reply.comment}")
 
     def _start_joints(self, values: tuple[float, ...], name: str) -> np.ndarray:
         q = np.asarray(values, float)
@@ -228,9 +284,10 @@ class ArmCore:
 
     @returns()
     def servo_off(self) -> None:
-        """All axes off; a moving arm stops first (the brakes then hold it where it stopped)."""
-        self.stop_motion()
+        """All axes off; a moving arm stops first (the brakes then hold it where it stopped).
+        New motions are refused at once; the state word keeps bit 0x01 until the arm is at rest."""
         self.servo = False
+        self.stop_motion()
 
     @returns(*GETTER)
     def get_state(self) -> dict:
@@ -243,10 +300,15 @@ class ArmCore:
         return {"pos": [*np.degrees(self._feedback), opening_mm]}
 
     @returns(*GETTER)
-    def get_manip_info(self) -> dict:
-        cycle_ms = round(self.executor.dt * 1000.0)
-        return {"manip_info": ("acti_ros2", "7-axis SRS arm with 1-axis gripper (PyBullet)",
-                               self.axis_count, cycle_ms, True)}
+    def get_manip_info(self) -> Reply:
+        period_ms = self.executor.dt * 1000.0
+        cycle_ms = round(period_ms)
+        info = ("acti_ros2", "7-axis SRS arm with 1-axis gripper (PyBullet)", self.axis_count,
+                cycle_ms, True)
+        comment = ("" if abs(period_ms - cycle_ms) < 1e-9 else
+                   f"cmd_cycle is rounded: the control period is {period_ms:.4f} ms "
+                   "(choose rate_hz so that it is a whole number of ms)")
+        return Reply(comment=comment, values={"manip_info": info})
 
     @returns(*GETTER)
     def get_active_alarm(self) -> dict:
@@ -353,18 +415,20 @@ class ArmCore:
     def set_max_speed_joint(self, speed: list[float]) -> None:
         v = finite_vector(speed, self.axis_count, "speed")
         for i, (x, hw) in enumerate(zip(v, self.hard_max_speed_joint)):
-            if not 0.0 < x <= hw + 1e-9:
-                raise value_error(f"speed[{i}] (J{i + 1}) is {x:g}°/s: it must be > 0 and at most "
-                                  f"the joint's rated {hw:.3f}°/s")
+            if not MIN_SPEED_JOINT_DEG_S <= x <= hw + 1e-9:
+                raise value_error(f"speed[{i}] (J{i + 1}) is {x:g}°/s: it must be at least "
+                                  f"{MIN_SPEED_JOINT_DEG_S:g}°/s and at most the joint's rated "
+                                  f"{hw:.3f}°/s")
         self.max_speed_joint = v
 
     @returns(*SETTER)
     def set_max_speed_cartesian(self, speed: tuple) -> None:
-        translation = finite_number(speed[0], "speed.translation")
-        rotation = finite_number(speed[1], "speed.rotation")
-        if translation <= 0 or rotation <= 0:
-            raise value_error(f"speed must be > 0 (translation {translation:g} mm/s, "
-                              f"rotation {rotation:g}°/s)")
+        if isinstance(speed, dict):
+            speed = (speed.get("translation"), speed.get("rotation"))
+        if len(speed) != 2:
+            raise value_error("speed needs translation and rotation")
+        translation = _in_range(speed[0], *SPEED_TRANSLATION_MM_S, "speed.translation", "mm/s")
+        rotation = _in_range(speed[1], *SPEED_ROTATION_DEG_S, "speed.rotation", "°/s")
         self.max_speed_cartesian = (translation, rotation)
 
     @returns(*SETTER)
@@ -372,17 +436,39 @@ class ArmCore:
         limits = np.empty((3, 2))
         for i, (axis, lim) in enumerate(zip("xyz", (x_limit, y_limit, z_limit))):
             upper, lower = self._limit_value(lim, f"{axis}_limit")
+            if max(abs(upper), abs(lower)) > SOFT_LIMIT_CARTESIAN_MM:
+                raise value_error(f"{axis}_limit [{lower:g}, {upper:g}] mm: each limit must be "
+                                  f"within ±{SOFT_LIMIT_CARTESIAN_MM:g} mm")
             limits[i] = lower, upper
         self.soft_limit_cartesian = limits
 
     @returns(*SETTER)
+    def set_soft_limit_box(self, box: tuple[float, ...]) -> Reply:
+        """set_soft_limit_cartesian with the limits in the config's order: x lower, x upper,
+        y lower, y upper, z lower, z upper (the parameter soft_limit_cartesian)."""
+        if len(box) != 6:
+            raise value_error("soft_limit_cartesian needs x lower, x upper, y lower, y upper, "
+                              f"z lower, z upper: 6 values, got {len(box)}")
+        return self.set_soft_limit_cartesian(*((box[i + 1], box[i]) for i in (0, 2, 4)))
+
+    def soft_limit_box(self) -> tuple[float, ...]:
+        """The Cartesian soft limits in the config's order (see set_soft_limit_box)."""
+        return tuple(float(x) for x in self.soft_limit_cartesian.reshape(-1))
+
+    @returns(*SETTER)
     def set_base_offset(self, offset: list[float]) -> None:
-        self.frames = Frames(hg_to_pose(offset, "offset"), self.frames.tool)
+        base = _offset(offset, BASE_OFFSET_MM, ReturnCode.VALUE_ERR)
+        self.frames = Frames(base, self.frames.tool)
 
     @returns(R.STATUS_ERR)
     def set_control_point_offset(self, offset: list[float]) -> None:
+        """Refused while anything runs, is paused mid-move or is queued: those targets were
+        planned with the present control point (5.4.23: not while moving)."""
+        if self.device.busy:
+            raise Refused(R.STATUS_ERR, "set_control_point_offset is refused while a motion is "
+                                        "running, paused or queued (wait or stop first)")
         self._check_idle("set_control_point_offset")
-        tool = hg_to_pose(offset, "offset", code=ReturnCode.NG)
+        tool = _offset(offset, CONTROL_POINT_OFFSET_MM, ReturnCode.NG)
         self.frames = Frames(self.frames.base, tool)
 
     @returns(*SETTER)
@@ -394,15 +480,17 @@ class ArmCore:
     # === middle-level port: motion control ======================================================
     @returns(*CONTROL)
     def pause(self) -> Reply | None:
+        """Holds the running move and whatever is queued behind it, also a move accepted and not
+        yet started (5.4.17 ignores pause only when servo off, alarmed, paused or stopped)."""
         why = self._control_ignored()
         if why is None and self.device.paused:
             why = "already paused"
-        if why is None and (self.device.current is None or self.device.stopping):
-            why = "the arm is not moving" if self.device.current is None else "it is stopping"
+        if why is None and (not self.device.busy or self.device.stopping):
+            why = "the arm is not moving" if not self.device.busy else "it is stopping"
         if why is not None:
             return _ignored(why)
         if not self.device.pause(self.current_ramp()):
-            return _ignored("already paused")
+            return _ignored("already paused or stopping")
         return None
 
     @returns(*CONTROL)
@@ -509,7 +597,8 @@ class ArmCore:
     # === state, feedback and progress (also for the node's topics and actions) =====================
     def state_word(self) -> int:
         d = self.device
-        word = STATE_SERVO_ON if self.servo else 0
+        # after servo_off the axes stay powered until the decelerating stop is at rest
+        word = STATE_SERVO_ON if self.servo or d.current is not None else 0
         if d.current is not None and not (d.paused and d.rate <= 0.0) \
                 or d.current is None and d.queue and not d.paused:
             word |= STATE_MOVING
@@ -576,8 +665,8 @@ class ArmCore:
             raise value_error(f"{name} needs upper and lower")
         upper = finite_number(lim[0], f"{name}.upper")
         lower = finite_number(lim[1], f"{name}.lower")
-        if upper < lower:
-            raise value_error(f"{name}: upper {upper:g} is below lower {lower:g}")
+        if upper <= lower:
+            raise value_error(f"{name}: upper {upper:g} must be above lower {lower:g}")
         return upper, lower
 
     def _accel_time(self, acl_time: float, minimum: float, setter: str) -> float:
@@ -585,14 +674,14 @@ class ArmCore:
         if t < minimum:
             raise value_error(f"acl_time {t:g} s is below the minimum accel time {minimum:g} s "
                               f"({setter} sets it)")
-        return t
+        return _in_range(t, minimum, MAX_ACCEL_TIME_S, "acl_time", "s")
 
     def _min_accel_time(self, acl_time: float) -> float:
         t = finite_number(acl_time, "acl_time")
         floor = 2 * self.executor.dt
         if t < floor:
             raise value_error(f"acl_time {t:g} s is below two control cycles ({floor:.4f} s)")
-        return t
+        return _in_range(t, floor, MAX_ACCEL_TIME_S, "acl_time", "s")
 
     def _check_joint_target(self, goal_deg: np.ndarray, name: str) -> None:
         lo, hi = self.soft_limit_joint[:, 0], self.soft_limit_joint[:, 1]
@@ -607,8 +696,29 @@ class ArmCore:
             car_point = (car_point.get("car_pos"), car_point.get("elbow"),
                          car_point.get("struct_flag", 0))
         pose = hg_to_pose(car_point[0], f"{name}.car_pos")
-        elbow = finite_number(car_point[1], f"{name}.elbow")
+        far = float(np.max(np.abs(pose[:3, 3]))) * 1000.0
+        if far > TARGET_MM:
+            raise value_error(f"{name}.car_pos: a translation of {far:.6g} mm is out of any reach "
+                              f"(at most ±{TARGET_MM:g} mm per axis)")
+        elbow = _in_range(car_point[1], -ELBOW_DEG, ELBOW_DEG, f"{name}.elbow", "°")
         return pose, math.radians(elbow)
+
+    def _check_reach(self, positions: np.ndarray, frames: Frames, label: str) -> None:
+        """Control-point positions (robot frame, m) no farther from the shoulder than the arm,
+        hand and control-point offset reach, else VALUE_ERR: checked before any IK or planning,
+        so a target kilometres away is refused at once."""
+        kin = self.kin
+        to_robot = inverse(frames.base)
+        shoulder = to_robot[:3, :3] @ kin.shoulder + to_robot[:3, 3]
+        radius = kin.reach + kin.hand + float(np.linalg.norm(frames.tool[:3, 3]))
+        dist = np.linalg.norm(positions - shoulder, axis=1)
+        far = np.flatnonzero(~(dist <= radius + 1e-9))
+        if len(far):
+            k = int(far[0])
+            where = ("the target" if k == len(positions) - 1 else
+                     f"the path at {100.0 * k / max(1, len(positions) - 1):.0f} %")
+            raise value_error(f"{label}: {where} is out of reach: {dist[k] * 1e3:.6g} mm from the "
+                              f"shoulder, the arm reaches {radius * 1e3:.1f} mm")
 
     def _check_cartesian_positions(self, positions_mm: np.ndarray, label: str) -> None:
         lim = self.soft_limit_cartesian
@@ -676,6 +786,7 @@ class ArmCore:
         def goal_of(start: ArmSetpoint) -> np.ndarray:
             target = target_of(frames.tool_of(kin.flange(start.joints)))
             self._check_cartesian_positions(target[None, :3, 3] * 1000.0, label)
+            self._check_reach(target[None, :3, 3], frames, label)
             flange = frames.flange_of(target)
             goal_psi, goal_turn = self._elbow_goal(start.joints, flange, psi, turn)
             try:
@@ -710,7 +821,11 @@ class ArmCore:
                 path = path_of(frames.tool_of(self.kin.flange(start.joints)))
             except ValueError as e:
                 raise value_error(f"{label}: {e}") from None
-            ss = np.linspace(0.0, 1.0, 1 + max(2, math.ceil(path.length / 0.002)))
+            coarse = np.array([path.position(s) for s in np.linspace(0.0, 1.0, REACH_SAMPLES + 1)])
+            self._check_cartesian_positions(coarse * 1000.0, label)
+            self._check_reach(coarse, frames, label)
+            ss = np.linspace(0.0, 1.0, min(MAX_CHECK_SAMPLES,
+                                           1 + max(2, math.ceil(path.length / 0.002))))
             self._check_cartesian_positions(np.array([path.position(s) for s in ss]) * 1000.0,
                                             label)
             goal_psi, goal_turn = self._elbow_goal(start.joints, frames.flange_of(path.pose(1.0)),
@@ -739,7 +854,21 @@ class ArmCore:
         return self._submit(plan, label)
 
     def _submit(self, plan: Callable[[ArmSetpoint], ArmMotion], label: str) -> dict:
-        motion_id = self.device.submit(plan, label)
+        def guarded(start: ArmSetpoint) -> ArmMotion:
+            """A refusal passes; any other failure of planning is this request's NG, said."""
+            try:
+                motion = plan(start)
+            except Refused:
+                raise
+            except Unreachable as e:
+                raise value_error(f"{label}: {e}") from None
+            except Exception as e:
+                raise Refused(R.NG, f"{label} could not be planned: {type(e).__name__}: {e}") \
+                    from None
+            if not math.isfinite(motion.duration):
+                raise value_error(f"{label}: the move would take forever at these settings")
+            return motion
+        motion_id = self.device.submit(guarded, label)
         if motion_id is None:
             raise Refused(R.FULL_MOTION_QUEUE_ERR,
                           f"the motion queue is full ({self.device.capacity} motions): wait or stop")

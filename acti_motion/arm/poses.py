@@ -30,6 +30,9 @@ def hg_to_pose(values: Iterable[float], name: str,
         raise Refused(code, r.comment) from None
     m = v.reshape(3, 4)
     R = m[:, :3]
+    if np.max(np.abs(R)) > 1.0 + ROTATION_TOLERANCE:      # no rotation has such entries
+        raise Refused(code, f"{name}: the 3×3 part is not a rotation: an entry is "
+                            f"{float(np.max(np.abs(R))):.6g}, a rotation's are within ±1")
     err = float(np.max(np.abs(R.T @ R - np.eye(3))))
     if err > ROTATION_TOLERANCE or np.linalg.det(R) <= 0:
         raise Refused(code, f"{name}: the 3×3 part is not a rotation (orthonormal, det +1): "
