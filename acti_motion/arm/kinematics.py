@@ -30,6 +30,7 @@ from acti_sim.world import ARM_JOINTS, URDF_PATH
 
 TWO_PI = 2.0 * math.pi
 LATERAL_CONE = 1e-3           # rad: where S→W is this close to ±y, ψ is measured from ẑ × u
+CLEAR = 0.2                   # rad: θ2, θ4, θ6 this far from 0 leave no doubt about the branch
 _EPS = 1e-9
 # Flags of CarPosWithElbow.struct_flag (reported; moves take the branch nearest the start).
 FLAG_SHOULDER = 0x1   # θ2 < 0
@@ -49,6 +50,45 @@ def rot_z(a: float) -> np.ndarray:
 def rot_y(a: float) -> np.ndarray:
     c, s = math.cos(a), math.sin(a)
     return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def rot_z_many(a: np.ndarray) -> np.ndarray:
+    """rot_z of each angle: (N, 3, 3)."""
+    c, s = np.cos(a), np.sin(a)
+    zero, one = np.zeros_like(c), np.ones_like(c)
+    return np.array([c, -s, zero, s, c, zero, zero, zero, one]).T.reshape(-1, 3, 3)
+
+
+def rot_zy_many(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """rot_z(a[i]) @ rot_y(b[i]) for each i: (N, 3, 3)."""
+    ca, sa, cb, sb = np.cos(a), np.sin(a), np.cos(b), np.sin(b)
+    return np.array([ca * cb, -sa, ca * sb, sa * cb, ca, sa * sb, -sb, np.zeros_like(ca),
+                     cb]).T.reshape(-1, 3, 3)
+
+
+def cross_many(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross products of (N, 3) arrays (np.cross costs more on small arrays)."""
+    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+
+
+def rotate_many(axes: np.ndarray, angles: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Each vector v[i] (or the one v) turned by angles[i] about the unit axes[i] (Rodrigues)."""
+    c, s = np.cos(angles)[:, None], np.sin(angles)[:, None]
+    return (v * c + cross_many(axes, v) * s
+            + axes * (np.sum(axes * v, axis=1)[:, None] * (1.0 - c)))
+
+
+def exp3_many(w: np.ndarray) -> np.ndarray:
+    """pin.exp3 of each rotation vector w[i]: (N, 3, 3)."""
+    angle = np.linalg.norm(w, axis=1)
+    k = w / np.maximum(angle, 1e-300)[:, None]
+    K = np.zeros((len(w), 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -k[:, 2], k[:, 1], -k[:, 0]
+    K = K - K.transpose(0, 2, 1)
+    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
+    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
 
 
 def rotate_about(axis: np.ndarray, angle: float) -> np.ndarray:
@@ -131,6 +171,22 @@ class ArmKinematics:
         pin.forwardKinematics(self.model, d, np.asarray(q, float))
         return pin.updateFramePlacement(self.model, d, self.flange_id).homogeneous
 
+    def flange_many(self, qs: np.ndarray) -> np.ndarray:
+        """Flange poses (N×4×4, m) of many postures at once, from the SRS geometry read off the
+        model (the same poses as `flange`, without a Pinocchio call per posture)."""
+        qs = np.asarray(qs, float)
+        R = rot_zy_many(qs[:, 0], qs[:, 1])
+        p = self.shoulder + self.upper_arm * R[:, :, 2]
+        R = R @ rot_zy_many(qs[:, 2], qs[:, 3])
+        p = p + self.forearm * R[:, :, 2]
+        R = R @ rot_zy_many(qs[:, 4], qs[:, 5])
+        p = p + self.hand * R[:, :, 2]
+        out = np.zeros((len(qs), 4, 4))
+        out[:, :3, :3] = R @ rot_z_many(qs[:, 6])
+        out[:, :3, 3] = p
+        out[:, 3, 3] = 1.0
+        return out
+
     def points(self, q: np.ndarray) -> ArmPoints:
         d = self.data
         pin.forwardKinematics(self.model, d, np.asarray(q, float))
@@ -194,7 +250,8 @@ class ArmKinematics:
                 | (FLAG_WRIST if q[5] < 0 else 0))
 
     def wrist_of(self, flange: np.ndarray) -> np.ndarray:
-        return flange[:3, 3] - self.hand * flange[:3, 2]
+        """The wrist point of a flange pose (4×4), or of each of many (N×4×4)."""
+        return flange[..., :3, 3] - self.hand * flange[..., :3, 2]
 
     # --- inverse kinematics ------------------------------------------------------------------------
     def solve(self, flange: np.ndarray, reference_q: np.ndarray, *, psi: float | None = None,
@@ -243,6 +300,63 @@ class ArmKinematics:
             raise Unreachable("no joint solution within the joint limits for this pose and elbow")
         self._verify(best, flange)
         return best
+
+    def solve_many(self, flanges: np.ndarray, elbow_dirs: np.ndarray, reference: np.ndarray, *,
+                   chained: bool) -> np.ndarray | None:
+        """`solve` for many flange poses at once (N×4×4, elbows towards elbow_dirs, N×3) where it
+        gives the same answers without a choice: every reference and solution clear of a branch
+        boundary (|θ2|, |θ4|, |θ6| > CLEAR), so the branch is the reference's, and within the
+        model's limits. `chained`: pose i is solved nearest to solution i − 1, the first nearest
+        to `reference` (7); else each nearest to reference[i] (N×7). None where that does not
+        hold for every pose (out of reach, near a boundary, a limit): `solve` one by one then
+        decides and says why."""
+        ref_signs = np.sign(reference[..., 1::2])
+        if (np.abs(reference[..., 1::2]) <= CLEAR).any():
+            return None
+        a, b = self.upper_arm, self.forearm
+        w = self.wrist_of(flanges)
+        v = w - self.shoulder
+        dist = np.linalg.norm(v, axis=1)
+        if ((dist > self.reach + 1e-9) | (dist < self.min_reach - 1e-9)).any():
+            return None
+        u = v / dist[:, None]
+        h = (a * a - b * b + dist * dist) / (2 * dist)
+        rho = np.sqrt(np.maximum(a * a - h * h, 0.0))
+        n = elbow_dirs - np.sum(elbow_dirs * u, axis=1)[:, None] * u
+        n /= np.linalg.norm(n, axis=1)[:, None]
+        elbow = self.shoulder + h[:, None] * u + rho[:, None] * n
+        q = self._branch_many(elbow, w, flanges[:, :3, :3], ref_signs)
+        if chained:
+            q = np.unwrap(np.vstack([reference, q]), axis=0)[1:]
+        else:
+            q = q + TWO_PI * np.round((reference - q) / TWO_PI)
+        if ((np.abs(q[:, 1::2]) <= CLEAR).any() or (q < self.lower - 1e-9).any()
+                or (q > self.upper + 1e-9).any()):
+            return None
+        got = self.flange_many(q)
+        if ((np.abs(got[:, :3, 3] - flanges[:, :3, 3]) > 1e-7).any()
+                or (np.abs(got[:, :3, :3] - flanges[:, :3, :3]) > 1e-6).any()):
+            return None
+        return q
+
+    def _branch_many(self, elbow: np.ndarray, wrist: np.ndarray, R: np.ndarray,
+                     signs: np.ndarray) -> np.ndarray:
+        """The one branch of `_branches` with the signs (of θ2, θ4, θ6) given per pose, for
+        poses clear of its singular cases."""
+        s2, s4, s6 = signs.T         # one sign each, or one per pose
+        ua = (elbow - self.shoulder) / self.upper_arm
+        t2 = s2 * np.arccos(np.clip(ua[:, 2], -1.0, 1.0))
+        t1 = np.arctan2(ua[:, 1], ua[:, 0]) + np.where(s2 < 0, math.pi, 0.0)
+        f = (wrist - elbow) / self.forearm
+        r12 = rot_zy_many(t1, t2)
+        f2 = np.einsum("nji,nj->ni", r12, f)
+        t4 = s4 * np.arccos(np.clip(f2[:, 2], -1.0, 1.0))
+        t3 = np.arctan2(s4 * f2[:, 1], s4 * f2[:, 0])
+        rw = (r12 @ rot_zy_many(t3, t4)).transpose(0, 2, 1) @ R
+        t6 = s6 * np.arccos(np.clip(rw[:, 2, 2], -1.0, 1.0))
+        t5 = np.arctan2(s6 * rw[:, 1, 2], s6 * rw[:, 0, 2])
+        t7 = np.arctan2(s6 * rw[:, 2, 1], -s6 * rw[:, 2, 0])
+        return np.stack([t1, t2, t3, t4, t5, t6, t7], axis=1)
 
     def _branches(self, elbow: np.ndarray, wrist: np.ndarray, R: np.ndarray, ref: np.ndarray):
         ua = (elbow - self.shoulder) / self.upper_arm
