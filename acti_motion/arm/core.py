@@ -708,6 +708,7 @@ class ArmCore:
         def plan(start: ArmSetpoint) -> ArmMotion:
             try:
                 path = path_of(frames.tool_of(self.kin.flange(start.joints)))
+                self.planner.check_length(path, frames)
             except ValueError as e:
                 raise value_error(f"{label}: {e}") from None
             ss = np.linspace(0.0, 1.0, 1 + max(2, math.ceil(path.length / 0.002)))

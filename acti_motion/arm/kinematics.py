@@ -302,42 +302,38 @@ class ArmKinematics:
         return best
 
     def solve_many(self, flanges: np.ndarray, elbow_dirs: np.ndarray, reference: np.ndarray, *,
-                   chained: bool) -> np.ndarray | None:
-        """`solve` for many flange poses at once (N×4×4, elbows towards elbow_dirs, N×3) where it
-        gives the same answers without a choice: every reference and solution clear of a branch
-        boundary (|θ2|, |θ4|, |θ6| > CLEAR), so the branch is the reference's, and within the
-        model's limits. `chained`: pose i is solved nearest to solution i − 1, the first nearest
-        to `reference` (7); else each nearest to reference[i] (N×7). None where that does not
-        hold for every pose (out of reach, near a boundary, a limit): `solve` one by one then
-        decides and says why."""
-        ref_signs = np.sign(reference[..., 1::2])
-        if (np.abs(reference[..., 1::2]) <= CLEAR).any():
-            return None
+                   chained: bool) -> tuple[np.ndarray, np.ndarray]:
+        """`solve` for many flange poses at once (N×4×4, elbows towards elbow_dirs, N×3), and which
+        of them it solved exactly as `solve` would: those whose reference and solution are clear
+        of a branch boundary (|θ2|, |θ4|, |θ6| > CLEAR, so the branch is the reference's) and
+        within the model's limits. `chained`: pose i is solved nearest to solution i − 1, the
+        first nearest to `reference` (7), and only a leading run counts as solved; else each
+        pose nearest to reference[i] (N×7). `solve` decides the others one by one (and says why
+        where there is no solution)."""
         a, b = self.upper_arm, self.forearm
         w = self.wrist_of(flanges)
         v = w - self.shoulder
-        dist = np.linalg.norm(v, axis=1)
-        if ((dist > self.reach + 1e-9) | (dist < self.min_reach - 1e-9)).any():
-            return None
+        dist = np.maximum(np.linalg.norm(v, axis=1), 1e-12)
         u = v / dist[:, None]
         h = (a * a - b * b + dist * dist) / (2 * dist)
         rho = np.sqrt(np.maximum(a * a - h * h, 0.0))
         n = elbow_dirs - np.sum(elbow_dirs * u, axis=1)[:, None] * u
-        n /= np.linalg.norm(n, axis=1)[:, None]
+        n /= np.maximum(np.linalg.norm(n, axis=1), 1e-12)[:, None]
         elbow = self.shoulder + h[:, None] * u + rho[:, None] * n
-        q = self._branch_many(elbow, w, flanges[:, :3, :3], ref_signs)
-        if chained:
-            q = np.unwrap(np.vstack([reference, q]), axis=0)[1:]
+        q = self._branch_many(elbow, w, flanges[:, :3, :3], np.sign(reference[..., 1::2]))
+        if chained:     # each nearest the one before: whole turns that add up along the poses
+            steps = np.diff(np.vstack([reference, q]), axis=0)
+            q = q - TWO_PI * np.cumsum(np.round(steps / TWO_PI), axis=0)
         else:
             q = q + TWO_PI * np.round((reference - q) / TWO_PI)
-        if ((np.abs(q[:, 1::2]) <= CLEAR).any() or (q < self.lower - 1e-9).any()
-                or (q > self.upper + 1e-9).any()):
-            return None
         got = self.flange_many(q)
-        if ((np.abs(got[:, :3, 3] - flanges[:, :3, 3]) > 1e-7).any()
-                or (np.abs(got[:, :3, :3] - flanges[:, :3, :3]) > 1e-6).any()):
-            return None
-        return q
+        ok = ((dist <= self.reach + 1e-9) & (dist >= self.min_reach - 1e-9)
+              & np.all(np.abs(q[:, 1::2]) > CLEAR, axis=1)
+              & np.all(np.abs(reference[..., 1::2]) > CLEAR, axis=-1)
+              & np.all((q >= self.lower - 1e-9) & (q <= self.upper + 1e-9), axis=1)
+              & np.all(np.abs(got[:, :3, 3] - flanges[:, :3, 3]) <= 1e-7, axis=1)
+              & np.all(np.abs(got[:, :3, :3] - flanges[:, :3, :3]) <= 1e-6, axis=(1, 2)))
+        return q, np.logical_and.accumulate(ok) if chained else ok
 
     def _branch_many(self, elbow: np.ndarray, wrist: np.ndarray, R: np.ndarray,
                      signs: np.ndarray) -> np.ndarray:

@@ -156,7 +156,7 @@ class LinePath:
         """Poses at each s (N×4×4)."""
         ss = np.asarray(ss, float)
         T = np.zeros((len(ss), 4, 4))
-        T[:, :3, :3] = exp3_many(ss[:, None] * self.w) @ self.R0
+        T[:, :3, :3] = exp3_many(ss[:, None] * self.w) @ self.R0 if self.angle else self.R0
         T[:, :3, 3] = self.positions(ss)
         T[:, 3, 3] = 1.0
         return T
@@ -255,6 +255,18 @@ class CartesianPlanner:
         timing = time_optimal(spline.ss, spline.qs, extents, limits)
         return CartesianPlan(spline, timing, turn, True, nominal)
 
+    def check_length(self, path, frames: Frames) -> None:
+        """Unreachable when `path` is longer than any path within the arm's reach: every control
+        point lies within reach + hand + the control-point offset of the shoulder, and no line
+        or arc inside a ball of radius r is longer than 2πr. This bounds every sampling of what
+        is accepted (an arc through a via point almost on the line runs the long way round a
+        huge circle)."""
+        radius = self.kin.reach + self.kin.hand + float(np.linalg.norm(frames.tool[:3, 3]))
+        if path.length > 2 * math.pi * radius:
+            raise Unreachable(f"out of reach: the path is {path.length * 1e3:.0f} mm long, and no "
+                              f"path within the arm's reach is longer than "
+                              f"{2 * math.pi * radius * 1e3:.0f} mm")
+
     # --- the elbow along the path: transported without twist, plus an even turn to the target ---
     def _elbow_plan(self, path, to_flange, start_q, psi, turn) -> "_ElbowPlan":
         kin = self.kin
@@ -325,7 +337,7 @@ class _ElbowPlan:
         f = ((ss - self.grid[i]) / (self.grid[i + 1] - self.grid[i]))[:, None]
         n = (1 - f) * self.base[i] + f * self.base[i + 1]
         n = _units(n - np.sum(n * us, axis=1)[:, None] * us)
-        return rotate_many(us, self.turn * ss, n)
+        return rotate_many(us, self.turn * ss, n) if self.turn else n
 
 
 class _PathIK:
@@ -352,20 +364,18 @@ class _PathIK:
     def chain(self, ss: np.ndarray, start_q: np.ndarray) -> np.ndarray:
         """Joints at ss (ss[0] = 0 is start_q), each solved from the one before."""
         flanges, dirs = self._targets(ss[1:])
-        qs = self.kin.solve_many(flanges, dirs, start_q, chained=True)
-        if qs is None:
-            qs = [start_q]
-            for s, F, d in zip(ss[1:], flanges, dirs):
-                qs.append(self._one(s, F, d, qs[-1]))
-            return np.array(qs)
-        return np.vstack([start_q, qs])
+        batch, ok = self.kin.solve_many(flanges, dirs, start_q, chained=True)
+        qs = [start_q, *batch[ok]]
+        for i in range(int(np.sum(ok)), len(flanges)):
+            qs.append(self._one(ss[i + 1], flanges[i], dirs[i], qs[-1]))
+        return np.array(qs)
 
     def between(self, ss: np.ndarray, refs: np.ndarray) -> np.ndarray:
         """Joints at ss, each solved from refs[i]."""
         flanges, dirs = self._targets(ss)
-        qs = self.kin.solve_many(flanges, dirs, refs, chained=False)
-        if qs is None:
-            qs = np.array([self._one(*args) for args in zip(ss, flanges, dirs, refs)])
+        qs, ok = self.kin.solve_many(flanges, dirs, refs, chained=False)
+        for i in np.flatnonzero(~ok):
+            qs[i] = self._one(ss[i], flanges[i], dirs[i], refs[i])
         return qs
 
 
@@ -389,7 +399,8 @@ def time_optimal(ss: np.ndarray, qs: np.ndarray, extents: np.ndarray,
     return ConstAccelTiming(gridpoints, sd)
 
 
-def _insert(ss: np.ndarray, qs: np.ndarray, where: np.ndarray, solve) -> tuple[np.ndarray, np.ndarray]:
+def _insert(ss: np.ndarray, qs: np.ndarray, where: np.ndarray,
+            solve) -> tuple[np.ndarray, np.ndarray]:
     """Insert the midpoints of the intervals `where`, solved from their left samples."""
     mids = (ss[where] + ss[where + 1]) / 2
     return np.insert(ss, where + 1, mids), np.insert(qs, where + 1, solve(mids, qs[where]), axis=0)
