@@ -11,6 +11,7 @@ within `PATH_TOLERANCE_MM` / `PATH_TOLERANCE_DEG`, and check the soft limits on 
 """
 from __future__ import annotations
 
+import functools
 import logging
 import math
 from dataclasses import dataclass
@@ -386,17 +387,26 @@ def time_optimal(ss: np.ndarray, qs: np.ndarray, extents: np.ndarray,
     way = np.hstack([qs, ss[:, None] * extents[None, :]])
     path = ta.SplineInterpolator(ss, way)
     cart_v = np.array([limits.speed, limits.angular_speed, limits.angular_speed])
-    vlim = np.concatenate([limits.joint_velocity, cart_v])
-    alim = np.concatenate([limits.joint_accel, cart_v / limits.ramp])
-    constraints = [ta.constraint.JointVelocityConstraint(np.stack([-vlim, vlim], axis=1)),
-                   ta.constraint.JointAccelerationConstraint(np.stack([-alim, alim], axis=1))]
+    constraints = _limit_constraints(
+        tuple(np.concatenate([limits.joint_velocity, cart_v])),
+        tuple(np.concatenate([limits.joint_accel, cart_v / limits.ramp])))
     gridpoints = np.linspace(ss[0], ss[-1], grid)
     instance = ta.algorithm.TOPPRA(constraints, path, gridpoints=gridpoints,
-                                   parametrizer="ParametrizeConstAccel")
+                                   solver_wrapper="seidel", parametrizer="ParametrizeConstAccel")
     sd = instance.compute_parameterization(0.0, 0.0)[1]
     if sd is None or np.any(np.isnan(sd)):
         raise Unreachable("no timing keeps the joint limits along this path")
     return ConstAccelTiming(gridpoints, sd)
+
+
+@functools.lru_cache(maxsize=16)
+def _limit_constraints(vlim: tuple[float, ...], alim: tuple[float, ...]) -> list:
+    """TOPP-RA's symmetric velocity and acceleration constraints, built once per set of limits
+    (building one formats its limits as text, a good part of a plan's cost; they keep no
+    state of a plan, so plans on any thread share them)."""
+    v, a = np.array(vlim), np.array(alim)
+    return [ta.constraint.JointVelocityConstraint(np.stack([-v, v], axis=1)),
+            ta.constraint.JointAccelerationConstraint(np.stack([-a, a], axis=1))]
 
 
 def _insert(ss: np.ndarray, qs: np.ndarray, where: np.ndarray,
