@@ -25,6 +25,11 @@ REACHING = np.array([[1.0, 0.0, 0.0, 0.5], [0.0, -1.0, 0.0, -0.4], [0.0, 0.0, -1
 RUNS = 15
 SINGULAR_FROM = (20.0, 40.0, 10.0, -70.0, 30.0, 25.0, 0.0)
 SINGULAR_TO = (-20.0, 40.0, -10.0, -70.0, -30.0, -25.0, 8.0)   # the wrist passes J6 = 0
+# the costliest of 150 random CP lines between postures (accepted; refused: a joint would jump)
+WORST_ACCEPTED = ((19.0, 69.0, 13.0, -51.0, -83.0, 1.0, 61.0),
+                  (59.0, 83.0, -25.0, -102.0, -115.0, -27.0, 65.0))
+WORST_REFUSED = ((-93.0, -1.0, 21.0, 7.0, 76.0, 36.0, 27.0),
+                 (-81.0, 0.0, -30.0, -41.0, 93.0, 1.0, 17.0))
 
 
 def rel(dx=0.0, dy=0.0, dz=0.0, rot=(0.0, 0.0, 0.0), elbow=0.0) -> tuple:
@@ -44,8 +49,11 @@ def main() -> None:
     arm.servo_on()
     arm.set_speed_joint(60)
     arm.set_speed_cartesian(100)
-    sing_target = arm.tool_pose(np.radians(SINGULAR_TO))
-    sing_elbow = math.degrees(kin.arm_angle(np.radians(SINGULAR_TO)))
+
+    def line_to(posture):
+        q = np.radians(posture)
+        target = (pose_to_hg(arm.tool_pose(q)), math.degrees(kin.arm_angle(q)), 0)
+        return lambda: arm.move_linear_cartesian_abs(target)
     cases = [
         ("PTP joint 0.5° × 7", reaching, lambda: arm.move_ptp_joint_rel([0.5] * 7)),
         ("PTP joint 60° J1", reaching, lambda: arm.move_ptp_joint_rel([-60.0] + [0.0] * 6)),
@@ -61,8 +69,9 @@ def main() -> None:
         ("CP elbow 90°", reaching, lambda: arm.move_linear_cartesian_rel(rel(elbow=-90.0))),
         ("CP arc r 500 mm, 106°", reaching,
          lambda: arm.move_circular_cartesian_rel(rel(dx=200.0, dy=400.0), rel(dy=800.0))),
-        ("CP near the wrist singularity", np.array(SINGULAR_FROM),
-         lambda: arm.move_linear_cartesian_abs((pose_to_hg(sing_target), sing_elbow, 0))),
+        ("CP near the wrist singularity", SINGULAR_FROM, line_to(SINGULAR_TO)),
+        ("CP worst accepted of 150", WORST_ACCEPTED[0], line_to(WORST_ACCEPTED[1])),
+        ("CP worst refused of 150", WORST_REFUSED[0], line_to(WORST_REFUSED[1])),
     ]
     print(f"one accept (checks + plan, no ROS) in ms, {RUNS} runs each: wall p50 and max, "
           "CPU p50")
@@ -75,13 +84,16 @@ def main() -> None:
             r = call()
             walls.append(time.perf_counter() - t0)
             cpus.append(time.thread_time() - c0)
-        assert r.ok, f"{name}: {r.comment}"
         walls, cpus = 1e3 * np.array(walls[1:]), 1e3 * np.array(cpus[1:])
-        motion = arm.device.queue[-1].motion
-        samples = len(getattr(motion.path, "ss", ())) or "-"
-        timing = "TOPP-RA" if isinstance(motion.timing, ConstAccelTiming) else "trapezoid"
+        if r.ok:
+            motion = arm.device.queue[-1].motion
+            samples = len(getattr(motion.path, "ss", ())) or "-"
+            what = "TOPP-RA" if isinstance(motion.timing, ConstAccelTiming) else "trapezoid"
+            what = f"{what:<9} samples {samples}"
+        else:
+            what = f"refused: {r.comment.split(': ', 1)[-1][:40]}"
         print(f"  {name:<30} wall {np.median(walls):7.2f} max {walls.max():7.2f}   "
-              f"CPU {np.median(cpus):7.2f}   {timing:<9} samples {samples}")
+              f"CPU {np.median(cpus):7.2f}   {what}")
     world.close()
 
 
