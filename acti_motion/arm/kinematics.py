@@ -321,13 +321,11 @@ class ArmKinematics:
             q = q - TWO_PI * np.cumsum(np.round(steps / TWO_PI), axis=0)
         else:
             q = q + TWO_PI * np.round((reference - q) / TWO_PI)
-        got = self.flange_many(q)
         ok = ((dist <= self.reach + 1e-9) & (dist >= self.min_reach - 1e-9)
               & np.all(np.abs(q[:, 1::2]) > CLEAR, axis=1)
               & np.all(np.abs(reference[..., 1::2]) > CLEAR, axis=-1)
               & np.all((q >= self.lower - 1e-9) & (q <= self.upper + 1e-9), axis=1)
-              & np.all(np.abs(got[:, :3, 3] - flanges[:, :3, 3]) <= 1e-7, axis=1)
-              & np.all(np.abs(got[:, :3, :3] - flanges[:, :3, :3]) <= 1e-6, axis=(1, 2)))
+              & self._reproduces(self.flange_many(q), flanges))
         return q, np.logical_and.accumulate(ok) if chained else ok
 
     def _branch_many(self, elbow: np.ndarray, wrist: np.ndarray, R: np.ndarray,
@@ -367,8 +365,13 @@ class ArmKinematics:
         nearest = np.take_along_axis(options, pick[..., None], axis=-1)[..., 0]
         return nearest, np.all(np.any(inside, axis=-1), axis=-1)
 
+    @staticmethod
+    def _reproduces(got: np.ndarray, want: np.ndarray) -> np.ndarray:
+        """Whether each pose of `got` is `want`'s (…×4×4) up to rounding: the IK's self-check."""
+        return (np.all(np.abs(got[..., :3, 3] - want[..., :3, 3]) <= 1e-7, axis=-1)
+                & np.all(np.abs(got[..., :3, :3] - want[..., :3, :3]) <= 1e-6, axis=(-2, -1)))
+
     def _verify(self, q: np.ndarray, flange: np.ndarray) -> None:
         got = self.flange(q)
-        if (np.max(np.abs(got[:3, 3] - flange[:3, 3])) > 1e-7
-                or np.max(np.abs(got[:3, :3] - flange[:3, :3])) > 1e-6):
+        if not self._reproduces(got, flange):
             raise AssertionError(f"IK solution does not reproduce the pose:\n{got}\n{flange}")

@@ -8,6 +8,11 @@ queue with the moves.
 CP moves sample the exact Cartesian path with the analytic IK (one solution per sample, each the
 nearest to the one before), refine the sampling until the joint spline reproduces the path
 within `PATH_TOLERANCE_MM` / `PATH_TOLERANCE_DEG`, and check the soft limits on the result.
+Planning runs on the service thread before a move is accepted, so it is vectorised: the IK of
+all samples at once where the branch is beyond doubt (`ArmKinematics.solve_many`), one by one
+near a branch boundary; the same samples and joints either way. Its cost is bounded: at most
+200 first samples, refinement to `MAX_SAMPLES`, a fixed TOPP-RA grid, and paths longer than any
+within the arm's reach refused before they are sampled (`CartesianPlanner.check_length`).
 """
 from __future__ import annotations
 
