@@ -60,7 +60,8 @@ def rot_zy_many(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def cross_many(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise cross products of (N, 3) arrays (np.cross costs more on small arrays)."""
+    """Cross products of 3-vectors, row-wise for (N, 3) arrays (np.cross costs more on small
+    arrays)."""
     return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
                      a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
                      a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
@@ -191,11 +192,11 @@ class ArmKinematics:
         """(e1, e2): the arm angle's zero direction and its +90° direction, normal to u = S→W."""
         for v, floor in ((np.array([0.0, 1.0, 0.0]), LATERAL_CONE),
                          (np.array([0.0, 0.0, 1.0]), 0.0)):
-            e1 = np.cross(v, u)
+            e1 = cross_many(v, u)
             n = np.linalg.norm(e1)
             if n > floor:
                 e1 = e1 / n
-                return e1, np.cross(u, e1)
+                return e1, cross_many(u, e1)
         raise AssertionError("unreachable: y and z cannot both be parallel to u")
 
     @staticmethod
@@ -225,7 +226,7 @@ class ArmKinematics:
     @staticmethod
     def transport(n: np.ndarray, u0: np.ndarray, u1: np.ndarray) -> np.ndarray:
         """The elbow direction n (normal to u0) carried to u1 by the smallest rotation."""
-        axis = np.cross(u0, u1)
+        axis = cross_many(u0, u1)
         sin, cos = float(np.linalg.norm(axis)), float(np.dot(u0, u1))
         if sin > 1e-12:
             n = rotate_about(axis / sin, math.atan2(sin, cos)) @ n
