@@ -7,11 +7,12 @@ import time
 import numpy as np
 import pinocchio as pin
 import pytest
+from scipy.interpolate import CubicSpline
 
 from acti_motion.arm.core import ArmConfig, ArmCore, shared_kinematics
 from acti_motion.arm.poses import Frames, pose_to_hg
 from acti_motion.arm.trajectories import (ArcPath, CartesianLimits, CartesianPlanner, LinePath,
-                                          poses_along, positions_along)
+                                          not_a_knot_spline, poses_along, positions_along)
 from acti_motion.replies import ReturnCode as R
 from sim_fixtures import executor  # noqa: F401
 
@@ -118,6 +119,17 @@ def test_a_path_longer_than_any_within_reach_is_refused_before_sampling(executor
     assert r.code == R.VALUE_ERR and "out of reach" in r.comment and "mm long" in r.comment
     assert arm.device.queue_length == 0
     assert arm.move_circular_cartesian_rel(rel(100.0, 100.0), rel(200.0, 0.0)).ok
+
+
+@pytest.mark.parametrize("n", [4, 9, 57])
+def test_the_joint_spline_is_scipy_s_not_a_knot_cubic_spline(n):
+    rng = np.random.default_rng(n)
+    xs = np.concatenate([[0.0], np.sort(rng.random(n - 2)), [1.0]])
+    ys = rng.normal(size=(n, 7))
+    ours, theirs = not_a_knot_spline(xs, ys), CubicSpline(xs, ys, axis=0)
+    assert np.allclose(ours.c, theirs.c, rtol=1e-12, atol=1e-12)
+    ts = np.linspace(-0.01, 1.01, 301)                 # extrapolates like CubicSpline too
+    assert np.allclose(ours(ts), theirs(ts), rtol=1e-12, atol=1e-12)
 
 
 def test_toppra_is_imported_with_the_planner():
