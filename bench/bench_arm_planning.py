@@ -1,7 +1,8 @@
 """Arm planning cost without ROS: time of one accept (checks + plan) per move kind and size,
 from a fixed start (the queue is emptied between calls, so every plan starts there): wall time
 and the thread's CPU time (steadier on a busy machine). Prints figures only (no timing asserts);
-runs in a few seconds, and on older checkouts too (before/after comparisons)."""
+runs in a few seconds, and on older checkouts too (before/after comparisons). Arguments pick
+the cases whose names contain them: `python bench/bench_arm_planning.py "20 mm" arc`."""
 import math
 import os
 import sys
@@ -75,7 +76,10 @@ def main() -> None:
     ]
     print(f"one accept (checks + plan, no ROS) in ms, {RUNS} runs each: wall p50 and max, "
           "CPU p50")
+    picked = sys.argv[1:]
     for name, start_deg, call in cases:
+        if picked and not any(p in name for p in picked):
+            continue
         start = ArmSetpoint(np.radians(start_deg), 0.0)
         walls, cpus, r = [], [], None
         for _ in range(RUNS + 1):                 # the first run warms up
