@@ -230,17 +230,22 @@ class ArcPath(LinePath):
         return self.center + rotate_many(axes, ss * self.sweep, self._r0)
 
 
+def _own(path) -> bool:
+    """A path of this module: poses at once, and `length` is the control point's path length
+    (the programs' paths define only `pose`, and their length is the tool point's)."""
+    return type(path) in (LinePath, ArcPath)
+
+
 def poses_along(path, ss: np.ndarray) -> np.ndarray:
-    """Poses of `path` at each s: at once for the paths of this module, one by one for others
-    (the programs' paths, which define only `pose`)."""
-    if type(path) in (LinePath, ArcPath):
+    """Poses of `path` at each s: at once for the paths of this module, one by one for others."""
+    if _own(path):
         return path.poses(ss)
     return np.array([path.pose(s) for s in ss])
 
 
 def positions_along(path, ss: np.ndarray) -> np.ndarray:
     """Positions of `path` at each s (N×3), as `poses_along`."""
-    if type(path) in (LinePath, ArcPath):
+    if _own(path):
         return path.positions(ss)
     return np.array([path.position(s) for s in ss])
 
@@ -288,13 +293,13 @@ class CartesianPlanner:
         return CartesianPlan(spline, timing, turn, True, nominal)
 
     def check_length(self, path, frames: Frames) -> None:
-        """Unreachable when `path` is longer than any path within the arm's reach: every control
-        point lies within reach + hand + the control-point offset of the shoulder, and no line
-        or arc inside a ball of radius r is longer than 2πr. This bounds every sampling of what
-        is accepted (an arc through a via point almost on the line runs the long way round a
-        huge circle)."""
+        """Unreachable when `path` (a line or arc of this module) is longer than any path within
+        the arm's reach: every control point lies within reach + hand + the control-point
+        offset of the shoulder, and no line or arc inside a ball of radius r is longer than 2πr.
+        This bounds every sampling of what is accepted (an arc through a via point almost on
+        the line runs the long way round a huge circle)."""
         radius = self.kin.reach + self.kin.hand + float(np.linalg.norm(frames.tool[:3, 3]))
-        if path.length > 2 * math.pi * radius:
+        if _own(path) and path.length > 2 * math.pi * radius:
             raise Unreachable(f"out of reach: the path is {path.length * 1e3:.0f} mm long, and no "
                               f"path within the arm's reach is longer than "
                               f"{2 * math.pi * radius * 1e3:.0f} mm")
