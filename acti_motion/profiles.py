@@ -30,6 +30,18 @@ class Trapezoid:
         """Peak of ds/dt (1/s)."""
         return 1.0 / (self.duration - self.ramp) if self.duration > 0.0 else 0.0
 
+    def sample_many(self, ts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(s, ds/dt, d²s/dt²) at each time of ts (the acceleration of the phase each is in)."""
+        T, ta, v = self.duration, self.ramp, self.peak
+        t = np.clip(np.asarray(ts, float), 0.0, T)
+        r = T - t
+        rising, falling = t < ta, t > T - ta
+        s = np.where(rising, v * t * t / (2 * ta),
+                     np.where(falling, 1.0 - v * r * r / (2 * ta), v * (t - ta / 2)))
+        sd = np.where(rising, v * t / ta, np.where(falling, v * r / ta, v))
+        sdd = np.where(rising, v / ta, np.where(falling, -v / ta, 0.0))
+        return s, sd, sdd
+
     def sample(self, t: float) -> tuple[float, float]:
         """(s, ds/dt) at time t, clamped to the profile's ends."""
         T, ta, v = self.duration, self.ramp, self.peak

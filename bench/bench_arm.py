@@ -58,7 +58,7 @@ def motion_figures() -> None:
     from acti_motion.executor import MotionExecutor
     from acti_motion.arm.poses import orientation_error_deg, pose_to_hg, position_error_mm
     from acti_motion.arm.trajectories import (CartesianLimits, ConstAccelTiming, LinePath,
-                                          load_toppra, time_optimal)
+                                              time_optimal)
     from acti_sim.world import World
 
     world = World()
@@ -87,7 +87,6 @@ def motion_figures() -> None:
 
     print("\nCP at 100 %: duration vs the TOPP-RA time-optimal bound (same joint and Cartesian "
           "limits), tracking in the simulation")
-    load_toppra()
     arm.set_speed_cartesian(100)
     cases = [("200 mm line", [0.2, 0.0, -0.2], None),
              ("300 mm line + 30° turn", [0.1, 0.25, -0.15], [0.0, 0.0, 30.0]),

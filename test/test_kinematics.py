@@ -66,3 +66,37 @@ def test_transport_keeps_the_elbow_normal_to_the_new_line(kin):
     u1 = np.array([1.0, 0.0, 1.0]) / math.sqrt(2)
     n1 = kin.transport(n0, u0, u1)
     assert abs(np.dot(n1, u1)) < 1e-12 and np.linalg.norm(n1) == pytest.approx(1.0)
+
+
+def test_flange_many_matches_pinocchio(kin):
+    qs = np.random.default_rng(3).uniform(kin.lower, kin.upper, (200, 7))
+    got = kin.flange_many(qs)
+    assert max(np.max(np.abs(F - kin.flange(q))) for F, q in zip(got, qs)) < 1e-12
+
+
+def test_solve_many_gives_solve_s_answers_where_it_says_it_solved(kin):
+    rng = np.random.default_rng(11)
+    qs = rng.uniform(kin.lower * 0.95, kin.upper * 0.95, (300, 7))
+    refs = qs + rng.normal(0.0, 0.03, qs.shape)
+    dirs = np.array([kin.elbow_direction(q)[1] for q in qs])
+    flanges = kin.flange_many(qs)
+    got, solved = kin.solve_many(flanges, dirs, refs, chained=False)
+    clear = np.all(np.abs(qs[:, 1::2]) > 0.25, axis=1) & np.all(np.abs(refs[:, 1::2]) > 0.25,
+                                                                   axis=1)
+    assert np.all(solved[clear]) and not np.all(solved)       # boundaries are left to solve()
+    for F, d, ref, q in zip(flanges[solved], dirs[solved], refs[solved], got[solved]):
+        assert np.max(np.abs(q - kin.solve(F, ref, elbow_dir=d))) < 1e-9
+
+
+def test_solve_many_chained_follows_the_turns_and_stops_at_the_first_doubt(kin):
+    q0 = np.radians([-100.0, -50.0, 20.0, -80.0, 30.0, 60.0, 10.0])   # θ2 < 0: raw θ1 is +260°
+    qs = q0 + np.linspace(0.0, 1.0, 12)[:, None] * np.radians([20.0, 0, 0, 0, 0, -58.0, 0])
+    dirs = np.array([kin.elbow_direction(q)[1] for q in qs])
+    got, solved = kin.solve_many(kin.flange_many(qs), dirs, q0, chained=True)
+    k = int(np.sum(solved))
+    assert 0 < k < len(qs) and np.all(solved[:k])             # J6 nears 0: the rest is solve()'s
+    assert np.max(np.abs(got[:k] - qs[:k])) < 1e-9             # θ1 a whole turn from the raw one
+    seq = [q0]
+    for F, d in zip(kin.flange_many(qs[:k]), dirs[:k]):
+        seq.append(kin.solve(F, seq[-1], elbow_dir=d))
+    assert np.max(np.abs(got[:k] - np.array(seq[1:]))) < 1e-9

@@ -30,3 +30,15 @@ def test_profile_is_continuous_and_ends_at_one():
 def test_zero_move_takes_no_time():
     p = Trapezoid.for_axes(np.zeros(3), np.ones(3), ramp=0.3)
     assert p.duration == 0.0 and p.sample(0.0) == (1.0, 0.0)
+
+
+@pytest.mark.parametrize("distance, ramp", [(2.0, 0.5), (0.01, 0.3)])
+def test_sample_many_matches_sample_and_gives_the_phase_acceleration(distance, ramp):
+    p = Trapezoid.for_axes(np.array([distance]), np.array([1.0]), ramp=ramp)
+    ts = np.linspace(-0.1, p.duration + 0.1, 501)
+    s, sd, sdd = p.sample_many(ts)
+    assert np.allclose(np.array([p.sample(t) for t in ts]), np.stack([s, sd], axis=1), atol=1e-12)
+    corners = np.array([0.0, ramp, p.duration - ramp, p.duration])
+    smooth = ((np.min(np.abs(ts[:, None] - corners), axis=1) > 2 * (ts[1] - ts[0]))
+              & (ts > 0.0) & (ts < p.duration))
+    assert np.allclose(np.gradient(sd, ts)[smooth], sdd[smooth], atol=1e-9)

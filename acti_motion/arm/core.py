@@ -29,7 +29,8 @@ from acti_motion.profiles import Trapezoid
 from acti_motion.replies import (Refused, Reply, ReturnCode, finite_number, finite_vector,
                                  ratio_percent, returns, value_error)
 from acti_motion.arm.trajectories import (ArcPath, ArmMotion, ArmSetpoint, CartesianLimits,
-                                      CartesianPlanner, LinearJointPath, LinePath, load_toppra)
+                                      CartesianPlanner, LinearJointPath, LinePath,
+                                      positions_along)
 from acti_sim.world import GRIPPER_JOINTS
 
 __all__ = ["ArmConfig", "ArmCore", "ArmSetpoint", "Alarm", "AlarmType"]
@@ -209,7 +210,6 @@ class ArmCore:
                                           ArmSetpoint(q0.copy(), self._finger))
         self._inside: np.ndarray | None = None
         executor.after_step(self._sample)
-        threading.Thread(target=load_toppra, name="toppra-import", daemon=True).start()
 
     def _apply_settings(self, c: ArmConfig) -> None:
         """The start-up settings that a service also sets, through that service's validation
@@ -754,8 +754,8 @@ class ArmCore:
             path = LinearJointPath(start.joints, goal)
             steps = 1 + max(1, math.ceil(np.max(np.abs(np.degrees(path.delta)))))
             ss = np.linspace(0.0, 1.0, steps)
-            positions = np.array([frames.tool_of(self.kin.flange(path.q(s)))[:3, 3] for s in ss])
-            self._check_cartesian_positions(positions * 1000.0, label)
+            positions = frames.tool_of(self.kin.flange_many(path.q0 + ss[:, None] * path.delta))
+            self._check_cartesian_positions(positions[:, :3, 3] * 1000.0, label)
             timing = Trapezoid.for_axes(path.delta, speed, ramp)
             return ArmMotion(path, timing, start.finger, start.finger, ramp, "joint")
         return self._submit(plan, label)
@@ -819,15 +819,15 @@ class ArmCore:
         def plan(start: ArmSetpoint) -> ArmMotion:
             try:
                 path = path_of(frames.tool_of(self.kin.flange(start.joints)))
+                self.planner.check_length(path, frames)
             except ValueError as e:
                 raise value_error(f"{label}: {e}") from None
-            coarse = np.array([path.position(s) for s in np.linspace(0.0, 1.0, REACH_SAMPLES + 1)])
+            coarse = positions_along(path, np.linspace(0.0, 1.0, REACH_SAMPLES + 1))
             self._check_cartesian_positions(coarse * 1000.0, label)
             self._check_reach(coarse, frames, label)
             ss = np.linspace(0.0, 1.0, min(MAX_CHECK_SAMPLES,
                                            1 + max(2, math.ceil(path.length / 0.002))))
-            self._check_cartesian_positions(np.array([path.position(s) for s in ss]) * 1000.0,
-                                            label)
+            self._check_cartesian_positions(positions_along(path, ss) * 1000.0, label)
             goal_psi, goal_turn = self._elbow_goal(start.joints, frames.flange_of(path.pose(1.0)),
                                                    psi, turn)
             try:

@@ -30,25 +30,59 @@ from acti_sim.world import ARM_JOINTS, URDF_PATH
 
 TWO_PI = 2.0 * math.pi
 LATERAL_CONE = 1e-3           # rad: where S→W is this close to ±y, ψ is measured from ẑ × u
+CLEAR = 0.2                   # rad: θ2, θ4, θ6 this far from 0 leave no doubt about the branch
 _EPS = 1e-9
 # Flags of CarPosWithElbow.struct_flag (reported; moves take the branch nearest the start).
 FLAG_SHOULDER = 0x1   # θ2 < 0
 FLAG_ELBOW = 0x2      # θ4 > 0
 FLAG_WRIST = 0x4      # θ6 < 0
+# The eight IK branches as signs of θ2, θ4, θ6, in the order they are tried (each sign then
+# flipped where the reference's is negative, so that the reference's branch comes first).
+BRANCH_SIGNS = np.array(list(product((1.0, -1.0), repeat=3)))
 
 
 class Unreachable(ValueError):
     """No joint solution: the comment says why (too far, too close, joint limits)."""
 
 
-def rot_z(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+def rot_z_many(a: np.ndarray) -> np.ndarray:
+    """The rotation about z by each angle: (N, 3, 3)."""
+    c, s = np.cos(a), np.sin(a)
+    zero, one = np.zeros_like(c), np.ones_like(c)
+    return np.array([c, -s, zero, s, c, zero, zero, zero, one]).T.reshape(-1, 3, 3)
 
 
-def rot_y(a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+def rot_zy_many(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Rotation about z by a[i], then about the new y by b[i], for each i: (N, 3, 3)."""
+    ca, sa, cb, sb = np.cos(a), np.sin(a), np.cos(b), np.sin(b)
+    return np.array([ca * cb, -sa, ca * sb, sa * cb, ca, sa * sb, -sb, np.zeros_like(ca),
+                     cb]).T.reshape(-1, 3, 3)
+
+
+def cross_many(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross products of 3-vectors, row-wise for (N, 3) arrays (np.cross costs more on small
+    arrays)."""
+    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+
+
+def rotate_many(axes: np.ndarray, angles: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Each vector v[i] (or the one v) turned by angles[i] about the unit axes[i] (Rodrigues)."""
+    c, s = np.cos(angles)[:, None], np.sin(angles)[:, None]
+    return (v * c + cross_many(axes, v) * s
+            + axes * (np.sum(axes * v, axis=1)[:, None] * (1.0 - c)))
+
+
+def exp3_many(w: np.ndarray) -> np.ndarray:
+    """pin.exp3 of each rotation vector w[i]: (N, 3, 3)."""
+    angle = np.linalg.norm(w, axis=1)
+    k = w / np.maximum(angle, 1e-300)[:, None]
+    K = np.zeros((len(w), 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -k[:, 2], k[:, 1], -k[:, 0]
+    K = K - K.transpose(0, 2, 1)
+    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
+    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
 
 
 def rotate_about(axis: np.ndarray, angle: float) -> np.ndarray:
@@ -131,6 +165,22 @@ class ArmKinematics:
         pin.forwardKinematics(self.model, d, np.asarray(q, float))
         return pin.updateFramePlacement(self.model, d, self.flange_id).homogeneous
 
+    def flange_many(self, qs: np.ndarray) -> np.ndarray:
+        """Flange poses (N×4×4, m) of many postures at once, from the SRS geometry read off the
+        model (the same poses as `flange`, without a Pinocchio call per posture)."""
+        qs = np.asarray(qs, float)
+        R = rot_zy_many(qs[:, 0], qs[:, 1])
+        p = self.shoulder + self.upper_arm * R[:, :, 2]
+        R = R @ rot_zy_many(qs[:, 2], qs[:, 3])
+        p = p + self.forearm * R[:, :, 2]
+        R = R @ rot_zy_many(qs[:, 4], qs[:, 5])
+        p = p + self.hand * R[:, :, 2]
+        out = np.zeros((len(qs), 4, 4))
+        out[:, :3, :3] = R @ rot_z_many(qs[:, 6])
+        out[:, :3, 3] = p
+        out[:, 3, 3] = 1.0
+        return out
+
     def points(self, q: np.ndarray) -> ArmPoints:
         d = self.data
         pin.forwardKinematics(self.model, d, np.asarray(q, float))
@@ -142,11 +192,11 @@ class ArmKinematics:
         """(e1, e2): the arm angle's zero direction and its +90° direction, normal to u = S→W."""
         for v, floor in ((np.array([0.0, 1.0, 0.0]), LATERAL_CONE),
                          (np.array([0.0, 0.0, 1.0]), 0.0)):
-            e1 = np.cross(v, u)
+            e1 = cross_many(v, u)
             n = np.linalg.norm(e1)
             if n > floor:
                 e1 = e1 / n
-                return e1, np.cross(u, e1)
+                return e1, cross_many(u, e1)
         raise AssertionError("unreachable: y and z cannot both be parallel to u")
 
     @staticmethod
@@ -176,7 +226,7 @@ class ArmKinematics:
     @staticmethod
     def transport(n: np.ndarray, u0: np.ndarray, u1: np.ndarray) -> np.ndarray:
         """The elbow direction n (normal to u0) carried to u1 by the smallest rotation."""
-        axis = np.cross(u0, u1)
+        axis = cross_many(u0, u1)
         sin, cos = float(np.linalg.norm(axis)), float(np.dot(u0, u1))
         if sin > 1e-12:
             n = rotate_about(axis / sin, math.atan2(sin, cos)) @ n
@@ -194,7 +244,8 @@ class ArmKinematics:
                 | (FLAG_WRIST if q[5] < 0 else 0))
 
     def wrist_of(self, flange: np.ndarray) -> np.ndarray:
-        return flange[:3, 3] - self.hand * flange[:3, 2]
+        """The wrist point of a flange pose (4×4), or of each of many (N×4×4)."""
+        return flange[..., :3, 3] - self.hand * flange[..., :3, 2]
 
     # --- inverse kinematics ------------------------------------------------------------------------
     def solve(self, flange: np.ndarray, reference_q: np.ndarray, *, psi: float | None = None,
@@ -225,74 +276,103 @@ class ArmKinematics:
         n = elbow_dir - np.dot(elbow_dir, u) * u
         n = n / np.linalg.norm(n)
         elbow = self.shoulder + h * u + rho * n
-        # The branch with the reference's signs of θ2, θ4, θ6 comes first; when none of those is
-        # near zero it is the nearest, and the search stops there.
-        clear = min(abs(ref[1]), abs(ref[3]), abs(ref[5])) > 0.2
-        best, best_cost = None, math.inf
-        for q in self._branches(elbow, w, R, ref):
-            q = self._nearest_in_limits(q, ref, lower, upper)
-            if q is None:
-                continue
-            if clear and best is None and np.all(np.sign(q[1::2]) == np.sign(ref[1::2])):
-                best = q
-                break
-            cost = float(np.sum((q - ref) ** 2))
-            if cost < best_cost:
-                best, best_cost = q, cost
-        if best is None:
+        # All eight branches at once, the reference's signs of θ2, θ4, θ6 first. When none of
+        # the reference's is near zero and the first branch within the limits has its signs, that
+        # one is the nearest and it is taken; else the nearest of those within the limits.
+        signs = BRANCH_SIGNS * np.where(ref[1::2] < 0, -1.0, 1.0)
+        q, inside = self._nearest_turns(
+            self._branch_many(np.broadcast_to(elbow, (8, 3)), np.broadcast_to(w, (8, 3)),
+                              np.broadcast_to(R, (8, 3, 3)), signs, ref), ref, lower, upper)
+        valid = np.flatnonzero(inside)
+        if not len(valid):
             raise Unreachable("no joint solution within the joint limits for this pose and elbow")
+        first = valid[0]
+        if (min(abs(ref[1]), abs(ref[3]), abs(ref[5])) > CLEAR
+                and np.all(np.sign(q[first, 1::2]) == np.sign(ref[1::2]))):
+            best = q[first]
+        else:
+            cost = np.where(inside, np.sum((q - ref) ** 2, axis=1), np.inf)
+            best = q[int(np.argmin(cost))]
         self._verify(best, flange)
         return best
 
-    def _branches(self, elbow: np.ndarray, wrist: np.ndarray, R: np.ndarray, ref: np.ndarray):
-        ua = (elbow - self.shoulder) / self.upper_arm
-        t2 = math.acos(max(-1.0, min(1.0, ua[2])))
-        if math.sin(t2) < 1e-9:
-            shoulders = [(ref[0], t2), (ref[0], -t2)]
+    def solve_many(self, flanges: np.ndarray, elbow_dirs: np.ndarray, reference: np.ndarray, *,
+                   chained: bool) -> tuple[np.ndarray, np.ndarray]:
+        """`solve` for many flange poses at once (N×4×4, elbows towards elbow_dirs, N×3), and which
+        of them it solved exactly as `solve` would: those whose reference and solution are clear
+        of a branch boundary (|θ2|, |θ4|, |θ6| > CLEAR, so the branch is the reference's) and
+        within the model's limits. `chained`: pose i is solved nearest to solution i − 1, the
+        first nearest to `reference` (7), and only a leading run counts as solved; else each
+        pose nearest to reference[i] (N×7). `solve` decides the others one by one (and says why
+        where there is no solution)."""
+        a, b = self.upper_arm, self.forearm
+        w = self.wrist_of(flanges)
+        v = w - self.shoulder
+        dist = np.maximum(np.linalg.norm(v, axis=1), 1e-12)
+        u = v / dist[:, None]
+        h = (a * a - b * b + dist * dist) / (2 * dist)
+        rho = np.sqrt(np.maximum(a * a - h * h, 0.0))
+        n = elbow_dirs - np.sum(elbow_dirs * u, axis=1)[:, None] * u
+        n /= np.maximum(np.linalg.norm(n, axis=1), 1e-12)[:, None]
+        elbow = self.shoulder + h[:, None] * u + rho[:, None] * n
+        q = self._branch_many(elbow, w, flanges[:, :3, :3], np.sign(reference[..., 1::2]),
+                              reference)
+        if chained:     # each nearest the one before: whole turns that add up along the poses
+            steps = np.diff(np.vstack([reference, q]), axis=0)
+            q = q - TWO_PI * np.cumsum(np.round(steps / TWO_PI), axis=0)
         else:
-            t1 = math.atan2(ua[1], ua[0])
-            shoulders = [(t1, t2), (t1 + math.pi, -t2)]
-        if ref[1] < 0:
-            shoulders.reverse()
-        elbows = (-1.0, 1.0) if ref[3] < 0 else (1.0, -1.0)
-        wrists = (-1.0, 1.0) if ref[5] < 0 else (1.0, -1.0)
+            q = q + TWO_PI * np.round((reference - q) / TWO_PI)
+        ok = ((dist <= self.reach + 1e-9) & (dist >= self.min_reach - 1e-9)
+              & np.all(np.abs(q[:, 1::2]) > CLEAR, axis=1)
+              & np.all(np.abs(reference[..., 1::2]) > CLEAR, axis=-1)
+              & np.all((q >= self.lower - 1e-9) & (q <= self.upper + 1e-9), axis=1)
+              & self._reproduces(self.flange_many(q), flanges))
+        return q, np.logical_and.accumulate(ok) if chained else ok
+
+    def _branch_many(self, elbow: np.ndarray, wrist: np.ndarray, R: np.ndarray,
+                     signs: np.ndarray, ref: np.ndarray) -> np.ndarray:
+        """Joint angles of the branches with the signs (of θ2, θ4, θ6; N×3, or 3 for all) for
+        elbow and wrist points (N×3) and flange rotations (N×3×3). Where a branch is singular
+        (sin θ2, θ4 or θ6 near 0) the free angle is the reference's (ref: N×7, or 7 for all)."""
+        s2, s4, s6 = signs.T         # one sign each, or one per pose
+        ua = (elbow - self.shoulder) / self.upper_arm
+        t2 = np.arccos(np.clip(ua[:, 2], -1.0, 1.0))
+        t1 = np.where(np.sin(t2) < 1e-9, ref[..., 0],
+                      np.arctan2(ua[:, 1], ua[:, 0]) + np.where(s2 < 0, math.pi, 0.0))
+        t2 = s2 * t2
         f = (wrist - elbow) / self.forearm
-        for (t1, t2), elbow_sign, wrist_sign in product(shoulders, elbows, wrists):
-            r12 = rot_z(t1) @ rot_y(t2)
-            f2 = r12.T @ f
-            t4 = elbow_sign * math.acos(max(-1.0, min(1.0, f2[2])))
-            if abs(math.sin(t4)) < 1e-9:
-                t3 = ref[2]
-            else:
-                sg = 1.0 if t4 > 0 else -1.0
-                t3 = math.atan2(sg * f2[1], sg * f2[0])
-            rw = (r12 @ rot_z(t3) @ rot_y(t4)).T @ R
-            t6 = wrist_sign * math.acos(max(-1.0, min(1.0, rw[2, 2])))
-            if abs(math.sin(t6)) < 1e-9:
-                t5 = ref[4]
-                t7 = math.atan2(rw[1, 0], rw[0, 0]) - t5
-            else:
-                sg = 1.0 if t6 > 0 else -1.0
-                t5 = math.atan2(sg * rw[1, 2], sg * rw[0, 2])
-                t7 = math.atan2(sg * rw[2, 1], -sg * rw[2, 0])
-            yield np.array([t1, t2, t3, t4, t5, t6, t7])
+        r12 = rot_zy_many(t1, t2)
+        f2 = np.einsum("nji,nj->ni", r12, f)
+        t4 = s4 * np.arccos(np.clip(f2[:, 2], -1.0, 1.0))
+        t3 = np.where(np.abs(np.sin(t4)) < 1e-9, ref[..., 2],
+                      np.arctan2(s4 * f2[:, 1], s4 * f2[:, 0]))
+        rw = (r12 @ rot_zy_many(t3, t4)).transpose(0, 2, 1) @ R
+        t6 = s6 * np.arccos(np.clip(rw[:, 2, 2], -1.0, 1.0))
+        wrist_free = np.abs(np.sin(t6)) < 1e-9
+        t5 = np.where(wrist_free, ref[..., 4], np.arctan2(s6 * rw[:, 1, 2], s6 * rw[:, 0, 2]))
+        t7 = np.where(wrist_free, np.arctan2(rw[:, 1, 0], rw[:, 0, 0]) - ref[..., 4],
+                      np.arctan2(s6 * rw[:, 2, 1], -s6 * rw[:, 2, 0]))
+        return np.stack([t1, t2, t3, t4, t5, t6, t7], axis=1)
 
     @staticmethod
-    def _nearest_in_limits(q: np.ndarray, ref: np.ndarray, lower: np.ndarray,
-                           upper: np.ndarray) -> np.ndarray | None:
-        """Each angle moved by whole turns to the value nearest the reference within its limits."""
-        out = np.empty(len(q))
-        for i, (x, r, lo, hi) in enumerate(zip(q, ref, lower, upper)):
-            k0 = round((r - x) / TWO_PI)
-            options = [x + TWO_PI * k for k in (k0 - 1, k0, k0 + 1)]
-            options = [y for y in options if lo - 1e-9 <= y <= hi + 1e-9]
-            if not options:
-                return None
-            out[i] = min(options, key=lambda y: abs(y - r))
-        return out
+    def _nearest_turns(q: np.ndarray, ref: np.ndarray, lower: np.ndarray,
+                       upper: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Each angle of the rows of q moved by whole turns to the value nearest the reference
+        within its limits, and which rows have such a value for every angle."""
+        k0 = np.round((ref - q) / TWO_PI)
+        options = q[..., None] + TWO_PI * (k0[..., None] + np.array([-1.0, 0.0, 1.0]))
+        inside = (options >= lower[:, None] - 1e-9) & (options <= upper[:, None] + 1e-9)
+        pick = np.argmin(np.where(inside, np.abs(options - ref[:, None]), np.inf), axis=-1)
+        nearest = np.take_along_axis(options, pick[..., None], axis=-1)[..., 0]
+        return nearest, np.all(np.any(inside, axis=-1), axis=-1)
+
+    @staticmethod
+    def _reproduces(got: np.ndarray, want: np.ndarray) -> np.ndarray:
+        """Whether each pose of `got` is `want`'s (…×4×4) up to rounding: the IK's self-check."""
+        return (np.all(np.abs(got[..., :3, 3] - want[..., :3, 3]) <= 1e-7, axis=-1)
+                & np.all(np.abs(got[..., :3, :3] - want[..., :3, :3]) <= 1e-6, axis=(-2, -1)))
 
     def _verify(self, q: np.ndarray, flange: np.ndarray) -> None:
         got = self.flange(q)
-        if (np.max(np.abs(got[:3, 3] - flange[:3, 3])) > 1e-7
-                or np.max(np.abs(got[:3, :3] - flange[:3, :3])) > 1e-6):
+        if not self._reproduces(got, flange):
             raise AssertionError(f"IK solution does not reproduce the pose:\n{got}\n{flange}")

@@ -8,9 +8,15 @@ queue with the moves.
 CP moves sample the exact Cartesian path with the analytic IK (one solution per sample, each the
 nearest to the one before), refine the sampling until the joint spline reproduces the path
 within `PATH_TOLERANCE_MM` / `PATH_TOLERANCE_DEG`, and check the soft limits on the result.
+Planning runs on the service thread before a move is accepted, so it is vectorised: the IK of
+all samples at once where the branch is beyond doubt (`ArmKinematics.solve_many`), one by one
+near a branch boundary; the same samples and joints either way. Its cost is bounded: at most
+200 first samples, refinement to `MAX_SAMPLES`, a fixed TOPP-RA grid, and paths longer than any
+within the arm's reach refused before they are sampled (`CartesianPlanner.check_length`).
 """
 from __future__ import annotations
 
+import functools
 import logging
 import math
 from dataclasses import dataclass
@@ -18,25 +24,23 @@ from typing import Protocol
 
 import numpy as np
 import pinocchio as pin
-from scipy.interpolate import CubicSpline
+import toppra as ta     # at start-up: the import takes most of a second, never in a request
+from scipy.interpolate import PPoly
+from scipy.linalg import solve_banded
 
-from acti_motion.arm.kinematics import ArmKinematics, Unreachable, rotate_about, wrap
-from acti_motion.arm.poses import Frames, rotation_angle
+from acti_motion.arm.kinematics import (ArmKinematics, Unreachable, exp3_many, rotate_many,
+                                        wrap)
+from acti_motion.arm.poses import Frames
 from acti_motion.profiles import Trapezoid
 from acti_sim.world import World
+
+logging.getLogger("toppra").setLevel(logging.WARNING)
 
 PATH_TOLERANCE_MM = 0.02
 PATH_TOLERANCE_DEG = 0.01
 MAX_JOINT_STEP = math.radians(2.0)   # between IK samples of a CP path
 MAX_SAMPLES = 4000
 TOPPRA_GRID = 201
-
-
-def load_toppra():
-    """toppra, imported on first use (the import takes about a second)."""
-    import toppra
-    logging.getLogger("toppra").setLevel(logging.WARNING)
-    return toppra
 
 
 @dataclass(frozen=True)
@@ -67,12 +71,38 @@ class LinearJointPath:
         return self.delta
 
 
+def not_a_knot_spline(xs: np.ndarray, ys: np.ndarray) -> PPoly:
+    """The cubic spline through (xs[i], ys[i]) (ys: N×dof, N ≥ 4) with not-a-knot ends: the
+    one scipy's CubicSpline(xs, ys, axis=0) builds, by the same equations, without its input
+    checks (a sixth of a short CP plan)."""
+    dx = np.diff(xs)[:, None]
+    slope = np.diff(ys, axis=0) / dx
+    n = len(xs)
+    A = np.zeros((3, n))                    # banded: upper, main, lower diagonal
+    A[1, 1:-1] = 2 * (dx[:-1, 0] + dx[1:, 0])
+    A[0, 2:] = dx[:-1, 0]
+    A[2, :-2] = dx[1:, 0]
+    b = np.empty_like(ys)
+    b[1:-1] = 3 * (dx[1:] * slope[:-1] + dx[:-1] * slope[1:])
+    d = xs[2] - xs[0]
+    A[1, 0], A[0, 1] = dx[1, 0], d
+    b[0] = ((dx[0] + 2 * d) * dx[1] * slope[0] + dx[0] ** 2 * slope[1]) / d
+    d = xs[-1] - xs[-3]
+    A[1, -1], A[2, -2] = dx[-2, 0], d
+    b[-1] = (dx[-1] ** 2 * slope[-2] + (2 * d + dx[-1]) * dx[-2] * slope[-1]) / d
+    ds = solve_banded((1, 1), A, b, overwrite_ab=True, overwrite_b=True, check_finite=False)
+    t = (ds[:-1] + ds[1:] - 2 * slope) / dx
+    return PPoly.construct_fast(np.stack([t / dx, (slope - ds[:-1]) / dx - t, ds[:-1],
+                                          ys[:-1]]), np.asarray(xs, float))
+
+
 class SplineJointPath:
     """A cubic spline through IK samples (s_i, q_i) of a Cartesian path."""
 
-    def __init__(self, ss: np.ndarray, qs: np.ndarray) -> None:
+    def __init__(self, ss: np.ndarray, qs: np.ndarray, spline: PPoly | None = None) -> None:
+        """`spline`: the one through (ss, qs) when the caller built it already."""
         self.ss, self.qs = ss, qs
-        self.spline = CubicSpline(ss, qs, axis=0)
+        self.spline = not_a_knot_spline(ss, qs) if spline is None else spline
         self.d1 = self.spline.derivative(1)
         self.d2 = self.spline.derivative(2)
 
@@ -104,7 +134,6 @@ class ConstAccelTiming:
     (toppra's ParametrizeConstAccel, which keeps the acceleration limits between grid points)."""
 
     def __init__(self, gridpoints: np.ndarray, velocities: np.ndarray) -> None:
-        ta = load_toppra()
         v = np.maximum(np.asarray(velocities, float), 0.0)
         if np.any(v[:-1] + v[1:] <= 0.0):
             raise Unreachable("the time-optimal timing stops inside the path")
@@ -151,14 +180,24 @@ class LinePath:
         self.length = float(np.linalg.norm(self.dp))
         self.angle = float(np.linalg.norm(self.w))
 
+    def positions(self, ss: np.ndarray) -> np.ndarray:
+        """Positions at each s (N×3)."""
+        return self.p0 + np.asarray(ss, float)[:, None] * self.dp
+
+    def poses(self, ss: np.ndarray) -> np.ndarray:
+        """Poses at each s (N×4×4)."""
+        ss = np.asarray(ss, float)
+        T = np.zeros((len(ss), 4, 4))
+        T[:, :3, :3] = exp3_many(ss[:, None] * self.w) @ self.R0 if self.angle else self.R0
+        T[:, :3, 3] = self.positions(ss)
+        T[:, 3, 3] = 1.0
+        return T
+
     def position(self, s: float) -> np.ndarray:
-        return self.p0 + s * self.dp
+        return self.positions(np.array([s]))[0]
 
     def pose(self, s: float) -> np.ndarray:
-        T = np.eye(4)
-        T[:3, :3] = pin.exp3(s * self.w) @ self.R0
-        T[:3, 3] = self.position(s)
-        return T
+        return self.poses(np.array([s]))[0]
 
 
 class ArcPath(LinePath):
@@ -185,8 +224,30 @@ class ArcPath(LinePath):
         self.length = self.radius * self.sweep
         self._r0 = r0
 
-    def position(self, s: float) -> np.ndarray:
-        return self.center + rotate_about(self.normal, s * self.sweep) @ self._r0
+    def positions(self, ss: np.ndarray) -> np.ndarray:
+        ss = np.asarray(ss, float)
+        axes = np.broadcast_to(self.normal, (len(ss), 3))
+        return self.center + rotate_many(axes, ss * self.sweep, self._r0)
+
+
+def _own(path) -> bool:
+    """A path of this module: poses at once, and `length` is the control point's path length
+    (the programs' paths define only `pose`, and their length is the tool point's)."""
+    return type(path) in (LinePath, ArcPath)
+
+
+def poses_along(path, ss: np.ndarray) -> np.ndarray:
+    """Poses of `path` at each s: at once for the paths of this module, one by one for others."""
+    if _own(path):
+        return path.poses(ss)
+    return np.array([path.pose(s) for s in ss])
+
+
+def positions_along(path, ss: np.ndarray) -> np.ndarray:
+    """Positions of `path` at each s (N×3), as `poses_along`."""
+    if _own(path):
+        return path.positions(ss)
+    return np.array([path.position(s) for s in ss])
 
 
 # --- planning ---------------------------------------------------------------------------------------
@@ -222,77 +283,77 @@ class CartesianPlanner:
         by what it takes to end at the arm angle `psi`."""
         elbow = self._elbow_plan(path, frames.flange_of, start_q, psi, turn)
         turn = elbow.turn
-        ss, qs = self._sample(path, frames, start_q, elbow)
-        spline = SplineJointPath(ss, qs)
+        spline = self._sample(path, frames, start_q, elbow)
         extents = np.array([path.length, path.angle, abs(turn)])
         speeds = np.array([limits.speed, limits.angular_speed, limits.angular_speed])
         nominal = Trapezoid.for_axes(extents, speeds, limits.ramp)
         if self._keeps_limits(spline, nominal, limits):
             return CartesianPlan(spline, nominal, turn, False, nominal)
-        timing = time_optimal(ss, qs, extents, limits)
+        timing = time_optimal(spline.ss, spline.qs, extents, limits)
         return CartesianPlan(spline, timing, turn, True, nominal)
+
+    def check_length(self, path, frames: Frames) -> None:
+        """Unreachable when `path` (a line or arc of this module) is longer than any path within
+        the arm's reach: every control point lies within reach + hand + the control-point
+        offset of the shoulder, and no line or arc inside a ball of radius r is longer than 2πr.
+        This bounds every sampling of what is accepted (an arc through a via point almost on
+        the line runs the long way round a huge circle)."""
+        radius = self.kin.reach + self.kin.hand + float(np.linalg.norm(frames.tool[:3, 3]))
+        if _own(path) and path.length > 2 * math.pi * radius:
+            raise Unreachable(f"out of reach: the path is {path.length * 1e3:.0f} mm long, and no "
+                              f"path within the arm's reach is longer than "
+                              f"{2 * math.pi * radius * 1e3:.0f} mm")
 
     # --- the elbow along the path: transported without twist, plus an even turn to the target ---
     def _elbow_plan(self, path, to_flange, start_q, psi, turn) -> "_ElbowPlan":
         kin = self.kin
         grid = np.linspace(0.0, 1.0, 1 + min(128, max(16, math.ceil(path.length / 0.005),
                                                       math.ceil(path.angle / 0.02))))
-        us = np.array([_unit(kin.wrist_of(to_flange(path.pose(s))) - kin.shoulder) for s in grid])
-        n = kin.elbow_direction(start_q)[1]
-        ns = np.empty_like(us)
-        for i, u in enumerate(us):
-            n = _unit(n - np.dot(n, u) * u)
-            ns[i] = n
+        us = _units(kin.wrist_of(to_flange(poses_along(path, grid))) - kin.shoulder)
+        n = kin.elbow_direction(start_q)[1].tolist()
+        ns = []
+        for u in us.tolist():              # plain floats: a short recurrence, numpy is slower
+            d = n[0] * u[0] + n[1] * u[1] + n[2] * u[2]
+            n = [n[0] - d * u[0], n[1] - d * u[1], n[2] - d * u[2]]
+            norm = math.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
+            n = [n[0] / norm, n[1] / norm, n[2] / norm]
+            ns.append(n)
+        ns = np.array(ns)
         if psi is not None:
             turn = wrap(psi - kin.angle_of(us[-1], ns[-1]))
         return _ElbowPlan(grid, ns, turn)
 
-    def _sample(self, path, frames, start_q, elbow) -> tuple[np.ndarray, np.ndarray]:
-        kin, to_flange = self.kin, frames.flange_of
+    def _sample(self, path, frames, start_q, elbow) -> SplineJointPath:
+        kin, ik = self.kin, _PathIK(self.kin, path, frames, elbow)
         count = 1 + max(8, math.ceil(path.length / 0.02), math.ceil(path.angle / 0.1),
                         math.ceil(abs(elbow.turn) / 0.1))
-        ss = list(np.linspace(0.0, 1.0, min(count, 200)))
-
-        def solve(s: float, ref: np.ndarray) -> np.ndarray:
-            F = to_flange(path.pose(s))
-            u = _unit(kin.wrist_of(F) - kin.shoulder)
-            try:
-                return kin.solve(F, ref, elbow_dir=elbow.direction(s, u))
-            except Unreachable as e:
-                raise Unreachable(f"at {100 * s:.1f} % of the path: {e}") from None
-
-        qs = [np.asarray(start_q, float)]
-        for s in ss[1:]:
-            qs.append(solve(s, qs[-1]))
+        ss = np.linspace(0.0, 1.0, min(count, 200))
+        qs = ik.chain(ss, np.asarray(start_q, float))
         # refine where a joint steps too far (a fast joint near a singularity, or a branch jump)
         for _ in range(40):
-            todo = [i for i in range(len(ss) - 1)
-                    if np.max(np.abs(qs[i + 1] - qs[i])) > MAX_JOINT_STEP]
-            if not todo:
+            todo = np.flatnonzero(np.max(np.abs(np.diff(qs, axis=0)), axis=1) > MAX_JOINT_STEP)
+            if not len(todo):
                 break
-            ss, qs = _insert(ss, qs, todo, solve)
-            if len(ss) > MAX_SAMPLES or min(np.diff(ss)) < 1e-7:
+            ss, qs = _insert(ss, qs, todo, ik.between)
+            if len(ss) > MAX_SAMPLES or np.min(np.diff(ss)) < 1e-7:
                 raise Unreachable("the path runs through a singularity (a joint would jump)")
         # refine where the spline strays from the path
         for _ in range(8):
-            spline = CubicSpline(ss, qs, axis=0)
-            mids = [(ss[i] + ss[i + 1]) / 2 for i in range(len(ss) - 1)]
-            todo = [i for i, s in enumerate(mids)
-                    if _strays(path.pose(s), frames.tool_of(kin.flange(spline(s))))]
-            if not todo:
-                break
-            ss, qs = _insert(ss, qs, todo, solve)
-        return np.array(ss), np.array(qs)
+            spline = not_a_knot_spline(ss, qs)
+            mids = (ss[:-1] + ss[1:]) / 2
+            got = frames.tool_of(kin.flange_many(spline(mids)))
+            todo = np.flatnonzero(_strays(poses_along(path, mids), got))
+            if not len(todo):
+                return SplineJointPath(ss, qs, spline)
+            ss, qs = _insert(ss, qs, todo, ik.between)
+        return SplineJointPath(ss, qs)
 
     @staticmethod
     def _keeps_limits(spline: SplineJointPath, nominal: Trapezoid,
                       limits: CartesianLimits) -> bool:
         if nominal.duration <= 0.0:
             return True
-        ts = np.linspace(0.0, nominal.duration, 401)
-        sv = np.array([nominal.sample(t) for t in ts])
-        s, sd = sv[:, 0], sv[:, 1]
-        sdd = np.gradient(sd, ts)
+        s, sd, sdd = nominal.sample_many(np.linspace(0.0, nominal.duration, 401))
         d1, d2 = spline.d1(s), spline.d2(s)
         qd = d1 * sd[:, None]
         qdd = d2 * (sd ** 2)[:, None] + d1 * sdd[:, None]
@@ -306,53 +367,101 @@ class _ElbowPlan:
     base: np.ndarray     # transported elbow directions on the grid
     turn: float
 
-    def direction(self, s: float, u: np.ndarray) -> np.ndarray:
-        i = min(int(s * (len(self.grid) - 1)), len(self.grid) - 2)
-        f = (s - self.grid[i]) / (self.grid[i + 1] - self.grid[i])
+    def directions(self, ss: np.ndarray, us: np.ndarray) -> np.ndarray:
+        """The elbow direction at each s, normal to the shoulder-wrist direction us[i] there."""
+        last = len(self.grid) - 1
+        i = np.minimum((ss * last).astype(int), last - 1)
+        f = ((ss - self.grid[i]) / (self.grid[i + 1] - self.grid[i]))[:, None]
         n = (1 - f) * self.base[i] + f * self.base[i + 1]
-        n = _unit(n - np.dot(n, u) * u)
-        return rotate_about(u, self.turn * s) @ n
+        n = _units(n - np.sum(n * us, axis=1)[:, None] * us)
+        return rotate_many(us, self.turn * ss, n) if self.turn else n
+
+
+class _PathIK:
+    """The joints along a Cartesian path: each sample the IK solution nearest to a reference
+    (the sample before it). Many samples are solved at once where `ArmKinematics.solve_many`
+    decides alone, else one by one with `ArmKinematics.solve` (same answers, and the reason
+    when there is none)."""
+
+    def __init__(self, kin: ArmKinematics, path, frames: Frames, elbow: _ElbowPlan) -> None:
+        self.kin, self.path, self.frames, self.elbow = kin, path, frames, elbow
+
+    def _targets(self, ss: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        flanges = self.frames.flange_of(poses_along(self.path, ss))
+        us = _units(self.kin.wrist_of(flanges) - self.kin.shoulder)
+        return flanges, self.elbow.directions(ss, us)
+
+    def _one(self, s: float, flange: np.ndarray, elbow_dir: np.ndarray,
+             ref: np.ndarray) -> np.ndarray:
+        try:
+            return self.kin.solve(flange, ref, elbow_dir=elbow_dir)
+        except Unreachable as e:
+            raise Unreachable(f"at {100 * s:.1f} % of the path: {e}") from None
+
+    def chain(self, ss: np.ndarray, start_q: np.ndarray) -> np.ndarray:
+        """Joints at ss (ss[0] = 0 is start_q), each solved from the one before."""
+        flanges, dirs = self._targets(ss[1:])
+        batch, ok = self.kin.solve_many(flanges, dirs, start_q, chained=True)
+        qs = [start_q, *batch[ok]]
+        for i in range(int(np.sum(ok)), len(flanges)):
+            qs.append(self._one(ss[i + 1], flanges[i], dirs[i], qs[-1]))
+        return np.array(qs)
+
+    def between(self, ss: np.ndarray, refs: np.ndarray) -> np.ndarray:
+        """Joints at ss, each solved from refs[i]."""
+        flanges, dirs = self._targets(ss)
+        qs, ok = self.kin.solve_many(flanges, dirs, refs, chained=False)
+        for i in np.flatnonzero(~ok):
+            qs[i] = self._one(ss[i], flanges[i], dirs[i], refs[i])
+        return qs
 
 
 def time_optimal(ss: np.ndarray, qs: np.ndarray, extents: np.ndarray,
                  limits: CartesianLimits, grid: int = TOPPRA_GRID) -> ConstAccelTiming:
     """TOPP-RA timing of the joint spline under the joint limits and the nominal Cartesian
     speed and acceleration (as three extra axes that grow linearly in s)."""
-    ta = load_toppra()
     way = np.hstack([qs, ss[:, None] * extents[None, :]])
     path = ta.SplineInterpolator(ss, way)
     cart_v = np.array([limits.speed, limits.angular_speed, limits.angular_speed])
-    vlim = np.concatenate([limits.joint_velocity, cart_v])
-    alim = np.concatenate([limits.joint_accel, cart_v / limits.ramp])
-    constraints = [ta.constraint.JointVelocityConstraint(np.stack([-vlim, vlim], axis=1)),
-                   ta.constraint.JointAccelerationConstraint(np.stack([-alim, alim], axis=1))]
+    constraints = _limit_constraints(
+        tuple(np.concatenate([limits.joint_velocity, cart_v])),
+        tuple(np.concatenate([limits.joint_accel, cart_v / limits.ramp])))
     gridpoints = np.linspace(ss[0], ss[-1], grid)
     instance = ta.algorithm.TOPPRA(constraints, path, gridpoints=gridpoints,
-                                   parametrizer="ParametrizeConstAccel")
+                                   solver_wrapper="seidel", parametrizer="ParametrizeConstAccel")
     sd = instance.compute_parameterization(0.0, 0.0)[1]
     if sd is None or np.any(np.isnan(sd)):
         raise Unreachable("no timing keeps the joint limits along this path")
     return ConstAccelTiming(gridpoints, sd)
 
 
-def _insert(ss, qs, where, solve):
-    """Insert the midpoints of the intervals `where` (solved from their left sample)."""
-    new_s, new_q = [ss[0]], [qs[0]]
-    marks = set(where)
-    for i in range(len(ss) - 1):
-        if i in marks:
-            m = (ss[i] + ss[i + 1]) / 2
-            new_s.append(m)
-            new_q.append(solve(m, qs[i]))
-        new_s.append(ss[i + 1])
-        new_q.append(qs[i + 1])
-    return new_s, new_q
+@functools.lru_cache(maxsize=16)
+def _limit_constraints(vlim: tuple[float, ...], alim: tuple[float, ...]) -> list:
+    """TOPP-RA's symmetric velocity and acceleration constraints, built once per set of limits
+    (building one formats its limits as text, a good part of a plan's cost; they keep no
+    state of a plan, so plans on any thread share them)."""
+    v, a = np.array(vlim), np.array(alim)
+    return [ta.constraint.JointVelocityConstraint(np.stack([-v, v], axis=1)),
+            ta.constraint.JointAccelerationConstraint(np.stack([-a, a], axis=1))]
 
 
-def _strays(want: np.ndarray, got: np.ndarray) -> bool:
-    return (np.linalg.norm(want[:3, 3] - got[:3, 3]) * 1000.0 > PATH_TOLERANCE_MM
-            or math.degrees(rotation_angle(want[:3, :3], got[:3, :3])) > PATH_TOLERANCE_DEG)
+def _insert(ss: np.ndarray, qs: np.ndarray, where: np.ndarray,
+            solve) -> tuple[np.ndarray, np.ndarray]:
+    """Insert the midpoints of the intervals `where`, solved from their left samples."""
+    mids = (ss[where] + ss[where + 1]) / 2
+    return np.insert(ss, where + 1, mids), np.insert(qs, where + 1, solve(mids, qs[where]), axis=0)
 
 
-def _unit(v: np.ndarray) -> np.ndarray:
-    return v / np.linalg.norm(v)
+def _strays(want: np.ndarray, got: np.ndarray) -> np.ndarray:
+    """Which poses of `got` miss those of `want` (N×4×4 each) by more than the path tolerance."""
+    off_mm = np.linalg.norm(want[:, :3, 3] - got[:, :3, 3], axis=1) * 1000.0
+    rel = got[:, :3, :3] @ want[:, :3, :3].transpose(0, 2, 1)
+    sin2 = np.stack([rel[:, 2, 1] - rel[:, 1, 2], rel[:, 0, 2] - rel[:, 2, 0],
+                     rel[:, 1, 0] - rel[:, 0, 1]], axis=1)
+    cos = (np.trace(rel, axis1=1, axis2=2) - 1.0) / 2
+    angle = np.degrees(np.arctan2(np.linalg.norm(sin2, axis=1) / 2, cos))
+    return (off_mm > PATH_TOLERANCE_MM) | (angle > PATH_TOLERANCE_DEG)
+
+
+def _units(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)

@@ -1,0 +1,136 @@
+"""CP planning without the simulation: the batch IK plans exactly what one-by-one IK plans, the
+paths' batch poses, the length bound that keeps every plan's cost bounded."""
+import math
+import sys
+import time
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from scipy.interpolate import CubicSpline
+
+from acti_motion.arm.core import ArmConfig, ArmCore, shared_kinematics
+from acti_motion.arm.poses import Frames, pose_to_hg
+from acti_motion.arm.trajectories import (ArcPath, CartesianLimits, CartesianPlanner, LinePath,
+                                          not_a_knot_spline, poses_along, positions_along)
+from acti_motion.replies import ReturnCode as R
+from sim_fixtures import executor  # noqa: F401
+
+WORK = np.radians([0.0, 45.0, 0.0, -90.0, 0.0, 45.0, 0.0])
+SINGULAR_FROM = np.radians([20.0, 40.0, 10.0, -70.0, 30.0, 25.0, 0.0])
+SINGULAR_TO = np.radians([-20.0, 40.0, -10.0, -70.0, -30.0, -25.0, 8.0])   # the wrist passes J6 = 0
+
+
+@pytest.fixture(scope="module")
+def kin():
+    return shared_kinematics()
+
+
+def limits(kin) -> CartesianLimits:
+    return CartesianLimits(speed=0.5, angular_speed=math.radians(90.0), ramp=0.3,
+                           joint_velocity=kin.velocity, joint_accel=kin.velocity / 0.1)
+
+
+def moved(P: np.ndarray, dp=(0.0, 0.0, 0.0), rot=(0.0, 0.0, 0.0)) -> np.ndarray:
+    out = P.copy()
+    out[:3, 3] += dp
+    out[:3, :3] = pin.exp3(np.radians(rot)) @ P[:3, :3]
+    return out
+
+
+def one_by_one(flanges, elbow_dirs, reference, *, chained):
+    """solve_many that solves nothing: every sample goes through ArmKinematics.solve."""
+    return np.zeros((len(flanges), 7)), np.zeros(len(flanges), bool)
+
+
+CASES = {
+    "200 mm line with a 30° turn": (WORK, lambda P: LinePath(P, moved(P, (0.1, 0.15, -0.1),
+                                                                      (0.0, 0.0, 30.0))), {}),
+    "arc": (WORK, lambda P: ArcPath(P, P[:3, 3] + [0.1, 0.1, 0.0], moved(P, (0.2, 0.0, 0.0))), {}),
+    "elbow turn": (WORK, lambda P: LinePath(P, P), {"turn": math.radians(60.0)}),
+    "elbow to an arm angle": (WORK, lambda P: LinePath(P, moved(P, (0.05, 0.0, -0.1))),
+                              {"psi": math.radians(25.0)}),
+    "near the wrist singularity": (SINGULAR_FROM, None, {}),
+}
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_batch_ik_plans_what_one_by_one_ik_plans(kin, monkeypatch, name):
+    start, path_of, elbow = CASES[name]
+    P0 = kin.flange(start)
+    path = LinePath(P0, kin.flange(SINGULAR_TO)) if path_of is None else path_of(P0)
+    planner, frames = CartesianPlanner(kin), Frames()
+    fast = planner.plan(path, frames, start, limits(kin), **elbow)
+    with monkeypatch.context() as m:
+        m.setattr(kin, "solve_many", one_by_one)
+        slow = planner.plan(path, frames, start, limits(kin), **elbow)
+    assert len(fast.path.ss) == len(slow.path.ss) and np.allclose(fast.path.ss, slow.path.ss)
+    assert np.max(np.abs(fast.path.qs - slow.path.qs)) < 1e-9
+    assert fast.retimed == slow.retimed
+    assert fast.retimed or path_of is not None          # the singular one needs TOPP-RA
+    assert fast.timing.duration == pytest.approx(slow.timing.duration, rel=1e-9)
+
+
+def test_batch_poses_are_the_poses_along_the_path(kin):
+    P0 = kin.flange(WORK)
+    ss = np.linspace(0.0, 1.0, 7)
+    line = LinePath(P0, moved(P0, (0.1, -0.2, 0.05), (10.0, -20.0, 30.0)))
+    for s, T in zip(ss, line.poses(ss)):
+        assert np.allclose(T[:3, :3], pin.exp3(s * line.w) @ line.R0, atol=1e-12)
+        assert np.allclose(T[:3, 3], line.p0 + s * line.dp, atol=1e-12)
+    arc = ArcPath(P0, P0[:3, 3] + [0.1, 0.1, 0.0], moved(P0, (0.2, 0.0, 0.0)))
+    ps = arc.positions(np.linspace(0.0, 1.0, 101))
+    assert np.allclose(np.linalg.norm(ps - arc.center, axis=1), arc.radius, atol=1e-12)
+    assert np.min(np.linalg.norm(ps - (P0[:3, 3] + [0.1, 0.1, 0.0]), axis=1)) < 0.002
+    assert np.allclose(ps[-1], P0[:3, 3] + [0.2, 0.0, 0.0], atol=1e-12)
+    assert np.allclose(arc.pose(0.3), arc.poses(np.array([0.3]))[0])
+
+
+def test_paths_of_other_modules_are_taken_one_by_one(kin):
+    class Shifted:                        # like the programs' paths: only pose and position
+        def __init__(self, path):
+            self.path, self.length, self.angle = path, path.length, path.angle
+
+        def pose(self, s):
+            return moved(self.path.pose(s), (0.0, 0.0, 0.01))
+
+        def position(self, s):
+            return self.pose(s)[:3, 3]
+    line = LinePath(kin.flange(WORK), moved(kin.flange(WORK), (0.1, 0.0, 0.0)))
+    ss = np.array([0.0, 0.5, 1.0])
+    assert np.allclose(poses_along(Shifted(line), ss)[:, :3, 3],
+                       line.positions(ss) + [0.0, 0.0, 0.01])
+    assert np.allclose(positions_along(Shifted(line), ss), line.positions(ss) + [0.0, 0.0, 0.01])
+
+
+def test_a_path_longer_than_any_within_reach_is_refused_before_sampling(executor):  # noqa: F811
+    arm = ArmCore(executor, ArmConfig(initial_joints_deg=tuple(np.degrees(WORK))))
+    arm.servo_on()
+    arm.set_speed_cartesian(50)
+
+    def rel(dx, dy):
+        m = np.eye(4)
+        m[:3, 3] = [dx / 1000, dy / 1000, 0.0]
+        return pose_to_hg(m), 0.0, 0
+    t0 = time.perf_counter()
+    # the via point is 0.4 µm off the line, beyond the end: the arc runs round a 50 km circle
+    r = arm.move_circular_cartesian_rel(rel(200.0, 0.0004), rel(100.0, 0.0))
+    assert time.perf_counter() - t0 < 1.0
+    assert r.code == R.VALUE_ERR and "out of reach" in r.comment and "mm long" in r.comment
+    assert arm.device.queue_length == 0
+    assert arm.move_circular_cartesian_rel(rel(100.0, 100.0), rel(200.0, 0.0)).ok
+
+
+@pytest.mark.parametrize("n", [4, 9, 57])
+def test_the_joint_spline_is_scipy_s_not_a_knot_cubic_spline(n):
+    rng = np.random.default_rng(n)
+    xs = np.concatenate([[0.0], np.sort(rng.random(n - 2)), [1.0]])
+    ys = rng.normal(size=(n, 7))
+    ours, theirs = not_a_knot_spline(xs, ys), CubicSpline(xs, ys, axis=0)
+    assert np.allclose(ours.c, theirs.c, rtol=1e-12, atol=1e-12)
+    ts = np.linspace(-0.01, 1.01, 301)                 # extrapolates like CubicSpline too
+    assert np.allclose(ours(ts), theirs(ts), rtol=1e-12, atol=1e-12)
+
+
+def test_toppra_is_imported_with_the_planner():
+    assert "toppra" in sys.modules            # at start-up, never inside the first request
