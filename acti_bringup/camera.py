@@ -1,0 +1,110 @@
+"""A camera looking at the work cell: `~/camera/image_raw` (rgb8) and `~/camera/camera_info`,
+rendered by PyBullet at `camera_rate_hz` (0, the default: off). Rendering runs on the simulation
+thread (PyBullet's client is not thread-safe) once every so many steps, never every step; it
+costs some milliseconds a frame (bench/bench_camera.py measures what it costs the simulation).
+
+The camera stands still in the world: its optical frame (z forward, x right, y down) hangs off
+`odom`, the world frame at start, on /tf_static."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import numpy as np
+import pinocchio as pin
+from rclpy.node import Node
+from sensor_msgs.msg import CameraInfo, Image
+from tf2_msgs.msg import TFMessage
+
+from acti_bringup.parameters import declare_config
+from acti_bringup.transforms import link_transform, static_tf_publisher
+from acti_motion.executor import MotionExecutor
+from acti_motion.link_poses import LinkTransform
+from acti_sim.world import World
+
+PARENT_FRAME = "odom"
+OPTICAL_FRAME = "camera_optical_frame"
+MAX_PIXELS = 1920 * 1080
+
+
+@dataclass
+class CameraConfig:
+    camera_rate_hz: float = 0.0        # images per second of simulated time on ~/camera/image_raw; 0: no camera (rendering takes simulation time)
+    camera_width: int = 320            # image width [px]
+    camera_height: int = 240           # image height [px]
+    camera_fov_deg: float = 60.0       # vertical field of view [degree]
+    camera_eye: tuple[float, ...] = (1.8, -1.4, 1.4)      # camera position in odom (the world at start) [m]
+    camera_target: tuple[float, ...] = (0.35, 0.0, 0.55)  # the point it looks at, in odom [m]
+
+
+def check_camera(c: CameraConfig) -> None:
+    """ValueError that says which camera parameter is wrong."""
+    numbers = [c.camera_rate_hz, c.camera_fov_deg, *c.camera_eye, *c.camera_target]
+    if not all(math.isfinite(x) for x in numbers) or c.camera_rate_hz < 0:
+        raise ValueError("camera_rate_hz must be >= 0 and the camera values finite")
+    if not (0 < c.camera_width and 0 < c.camera_height
+            and c.camera_width * c.camera_height <= MAX_PIXELS):
+        raise ValueError(f"camera_width × camera_height must be positive, at most {MAX_PIXELS} px")
+    if not 0 < c.camera_fov_deg < 180:
+        raise ValueError("camera_fov_deg must be in (0, 180)")
+    if len(c.camera_eye) != 3 or len(c.camera_target) != 3:
+        raise ValueError("camera_eye and camera_target are x, y, z")
+    view = np.subtract(c.camera_target, c.camera_eye)
+    if np.linalg.norm(np.cross(view, [0.0, 0.0, 1.0])) < 1e-6 * max(1.0, np.linalg.norm(view)):
+        raise ValueError("camera_target must not be straight above or below camera_eye")
+
+
+def optical_frame(eye: tuple[float, ...], target: tuple[float, ...]) -> LinkTransform:
+    """The optical frame (z towards the target, x right, y down; the image upright) in odom."""
+    z = np.subtract(target, eye) / np.linalg.norm(np.subtract(target, eye))
+    x = np.cross(z, [0.0, 0.0, 1.0])
+    x /= np.linalg.norm(x)
+    rotation = np.column_stack([x, np.cross(z, x), z])
+    q = pin.Quaternion(rotation).coeffs()
+    return LinkTransform(PARENT_FRAME, OPTICAL_FRAME, tuple(float(v) for v in eye),
+                         tuple(float(v) for v in q))
+
+
+def camera_info(width: int, height: int, fov_deg: float) -> CameraInfo:
+    """Intrinsics of PyBullet's projection: square pixels, principal point at the centre."""
+    f = (height / 2) / math.tan(math.radians(fov_deg) / 2)
+    cx, cy = width / 2 - 0.5, height / 2 - 0.5
+    info = CameraInfo(width=width, height=height, distortion_model="plumb_bob")
+    info.d = [0.0] * 5
+    info.k = [f, 0.0, cx, 0.0, f, cy, 0.0, 0.0, 1.0]
+    info.r = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
+    info.p = [f, 0.0, cx, 0.0, 0.0, f, cy, 0.0, 0.0, 0.0, 1.0, 0.0]
+    info.header.frame_id = OPTICAL_FRAME
+    return info
+
+
+class SimCamera:
+    """Renders and publishes the work-cell camera when `camera_rate_hz` > 0."""
+
+    def __init__(self, node: Node, executor: MotionExecutor, now: Callable[[], Any]) -> None:
+        self.config = c = declare_config(node, CameraConfig)
+        check_camera(c)
+        if c.camera_rate_hz == 0:
+            return
+        self._now = now
+        self._info = camera_info(c.camera_width, c.camera_height, c.camera_fov_deg)
+        self._image = node.create_publisher(Image, "~/camera/image_raw", 2)
+        self._info_pub = node.create_publisher(CameraInfo, "~/camera/camera_info", 2)
+        self._static = static_tf_publisher(node)
+        self._static.publish(TFMessage(transforms=[
+            link_transform(now(), optical_frame(c.camera_eye, c.camera_target))]))
+        rate = 1.0 / executor.dt
+        executor.after_step(self._publish, every=max(1, round(rate / c.camera_rate_hz)))
+
+    def _publish(self, world: World) -> None:
+        c = self.config
+        rgb = world.render(c.camera_eye, c.camera_target, c.camera_fov_deg,
+                           c.camera_width, c.camera_height)
+        stamp = self._now()
+        image = Image(height=c.camera_height, width=c.camera_width, encoding="rgb8",
+                      step=3 * c.camera_width, data=rgb.tobytes())
+        image.header.stamp = self._info.header.stamp = stamp
+        image.header.frame_id = OPTICAL_FRAME
+        self._image.publish(image)
+        self._info_pub.publish(self._info)
