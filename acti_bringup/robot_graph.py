@@ -14,7 +14,7 @@ from tf2_msgs.msg import TFMessage
 
 from acti_bringup.parameters import declare_config
 from acti_bringup.transforms import LATCHED_QOS, link_transform, static_tf_publisher, tf_publisher
-from acti_motion.link_poses import LinkPoses
+from acti_motion.link_poses import LinkPoses, LinkTransform
 from acti_motion.executor import MotionExecutor
 from acti_sim.world import World
 
@@ -43,10 +43,19 @@ class RobotGraph:
         self._static.publish(TFMessage(transforms=[
             link_transform(stamp, t) for t in self.links.fixed_transforms()]))
         self._tf = tf_publisher(node)
+        # one message, filled in place each time: building it anew cost ten times as much
+        self._message = TFMessage(transforms=[
+            link_transform(stamp, LinkTransform(j.parent, j.child, (0.0, 0.0, 0.0),
+                                                (0.0, 0.0, 0.0, 1.0)))
+            for j in self.links.movable])
         executor.after_step(self._publish_links, every=every)
 
     def _publish_links(self, world: World) -> None:
         names, positions, _ = world.joint_states()
+        poses = self.links.movable_poses(names, positions).tolist()
         stamp = self._now()
-        self._tf.publish(TFMessage(transforms=[
-            link_transform(stamp, t) for t in self.links.movable_transforms(names, positions)]))
+        for msg, (x, y, z, qx, qy, qz, qw) in zip(self._message.transforms, poses):
+            msg.header.stamp = stamp
+            t, r = msg.transform.translation, msg.transform.rotation
+            t.x, t.y, t.z, r.x, r.y, r.z, r.w = x, y, z, qx, qy, qz, qw
+        self._tf.publish(self._message)

@@ -3,6 +3,7 @@ Pinocchio forward kinematics over the whole URDF model: what robot_state_publish
 without its node. Fixed joints never change; movable ones follow the joints."""
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from typing import Sequence
@@ -58,11 +59,13 @@ class LinkPoses:
         self._q = pin.neutral(self.model)
 
     def fixed_transforms(self) -> list[LinkTransform]:
-        return self._transforms(self.fixed, self._q)
+        poses = self._poses(self.fixed, self._q)
+        return [LinkTransform(j.parent, j.child, tuple(p[:3]), tuple(p[3:]))
+                for j, p in zip(self.fixed, poses.tolist())]
 
-    def movable_transforms(self, names: Sequence[str], positions: Sequence[float]
-                           ) -> list[LinkTransform]:
-        """The movable joints' transforms; joints not named keep their last value."""
+    def movable_poses(self, names: Sequence[str], positions: Sequence[float]) -> np.ndarray:
+        """Row k: the child link of `movable[k]` in its parent link, as translation x, y, z (m)
+        and quaternion x, y, z, w. Joints not named keep their last value."""
         q = self._q
         for name, value in zip(names, positions):
             slot = self._slot.get(name)
@@ -70,18 +73,13 @@ class LinkPoses:
                 continue
             i, nq = slot
             if nq == 2:
-                q[i], q[i + 1] = np.cos(value), np.sin(value)
+                q[i], q[i + 1] = math.cos(value), math.sin(value)
             else:
                 q[i] = value
-        return self._transforms(self.movable, q)
+        return self._poses(self.movable, q)
 
-    def _transforms(self, joints: list[UrdfJoint], q: np.ndarray) -> list[LinkTransform]:
+    def _poses(self, joints: list[UrdfJoint], q: np.ndarray) -> np.ndarray:
         pin.framesForwardKinematics(self.model, self.data, q)
-        out = []
-        for j in joints:
-            rel = self.data.oMf[self._frame[j.parent]].actInv(self.data.oMf[self._frame[j.child]])
-            t, quat = rel.translation, pin.Quaternion(rel.rotation).coeffs()
-            out.append(LinkTransform(j.parent, j.child, (float(t[0]), float(t[1]), float(t[2])),
-                                     (float(quat[0]), float(quat[1]), float(quat[2]),
-                                      float(quat[3]))))
-        return out
+        oMf, frame = self.data.oMf, self._frame
+        return np.array([pin.SE3ToXYZQUAT(oMf[frame[j.parent]].actInv(oMf[frame[j.child]]))
+                         for j in joints])

@@ -1,0 +1,64 @@
+"""What the ROS-graph topics cost the simulation: the main job run as fast as it can
+(real_time_factor 0), its real-time factor read off /clock, and at real time (1.0) its CPU use,
+with the links' TF off and on and the camera off and on (two sizes, two rates)."""
+from __future__ import annotations
+
+import os
+import time
+
+from common import RosClient, running
+
+from rosgraph_msgs.msg import Clock
+from rclpy.qos import QoSProfile
+
+WINDOW_S = 8.0
+CASES = [
+    ("no link TF, no camera", ["link_tf:=false"]),
+    ("link TF (default)", []),
+    ("link TF + camera 320×240 at 2 Hz", ["camera_rate_hz:=2.0"]),
+    ("link TF + camera 320×240 at 10 Hz", ["camera_rate_hz:=10.0"]),
+    ("link TF + camera 640×480 at 5 Hz", ["camera_rate_hz:=5.0", "camera_width:=640",
+                                         "camera_height:=480"]),
+]
+
+
+def cpu_seconds(pid: int) -> float:
+    with open(f"/proc/{pid}/stat") as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def measure(ros: RosClient, pid: int) -> tuple[float, float]:
+    """(simulated seconds per wall second, CPU fraction of one core) over WINDOW_S."""
+    latest: list[Clock] = []
+    sub = ros.node.create_subscription(Clock, "/clock", lambda m: latest.append(m),
+                                       QoSProfile(depth=1))
+    try:
+        if not ros.spin_until(lambda: latest, 30.0):
+            raise TimeoutError("no /clock")
+        ros.spin_until(lambda: False, 2.0)                       # start-up over
+        t0, c0, s0 = time.monotonic(), cpu_seconds(pid), latest[-1].clock
+        ros.spin_until(lambda: False, WINDOW_S)
+        t1, c1, s1 = time.monotonic(), cpu_seconds(pid), latest[-1].clock
+    finally:
+        ros.node.destroy_subscription(sub)
+    sim = (s1.sec - s0.sec) + (s1.nanosec - s0.nanosec) * 1e-9
+    return sim / (t1 - t0), (c1 - c0) / (t1 - t0)
+
+
+def main() -> None:
+    ros = RosClient()
+    try:
+        print(f"{'case':<36} {'RTF, as fast as it can':>24} {'CPU at real time':>18}")
+        for name, params in CASES:
+            with running("acti_bringup", "real_time_factor:=0.0", *params) as node:
+                fastest, _ = measure(ros, node.proc.pid)
+            with running("acti_bringup", "real_time_factor:=1.0", *params) as node:
+                rtf, cpu = measure(ros, node.proc.pid)
+            print(f"{name:<36} {fastest:>22.2f} × {100 * cpu:>15.0f} %   (RTF {rtf:.3f})")
+    finally:
+        ros.close()
+
+
+if __name__ == "__main__":
+    main()
