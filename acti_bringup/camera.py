@@ -1,13 +1,20 @@
-"""A camera looking at the work cell: `~/camera/image_raw` (rgb8) and `~/camera/camera_info`,
-rendered by PyBullet at `camera_rate_hz` (0, the default: off). Rendering runs on the simulation
-thread (PyBullet's client is not thread-safe) once every so many steps, never every step; it
-costs some milliseconds a frame (bench/bench_camera.py measures what it costs the simulation).
+"""A camera looking at the work cell: `~/camera/image_raw` (rgb8) and `~/camera/camera_info`
+at `camera_rate_hz` of simulated time (0, the default: off).
+
+PyBullet's renderer takes tens of milliseconds a frame and holds the GIL all along, which would
+stall every service of the process: frames are rendered in a process of their own, by a copy
+of the world that the simulation thread poses (`World.placement`, microseconds) once a frame.
+A frame asked for while the last one is still rendering is skipped. What the camera costs the
+simulation: bench/bench_ros_graph.py.
 
 The camera stands still in the world: its optical frame (z forward, x right, y down) hangs off
 `odom`, the world frame at start, on /tf_static."""
 from __future__ import annotations
 
 import math
+import multiprocessing
+import signal
+import threading
 from dataclasses import dataclass
 from typing import Any, Callable
 
@@ -79,32 +86,73 @@ def camera_info(width: int, height: int, fov_deg: float) -> CameraInfo:
     return info
 
 
+def render_frames(requests: Any, frames: Any, urdf_path: str, config: CameraConfig) -> None:
+    """The render process: pose a copy of the world as asked, send back the RGB bytes; ends
+    when the simulation's end of the pipe closes. SIGINT is the host's to handle."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    world = World(urdf_path=urdf_path)
+    c = config
+    try:
+        while True:
+            world.show(requests.recv())
+            frames.send_bytes(world.render(c.camera_eye, c.camera_target, c.camera_fov_deg,
+                                           c.camera_width, c.camera_height).tobytes())
+    except (EOFError, OSError):
+        pass
+    finally:
+        world.close()
+
+
 class SimCamera:
-    """Renders and publishes the work-cell camera when `camera_rate_hz` > 0."""
+    """Publishes the work-cell camera when `camera_rate_hz` > 0."""
 
     def __init__(self, node: Node, executor: MotionExecutor, now: Callable[[], Any]) -> None:
         self.config = c = declare_config(node, CameraConfig)
         check_camera(c)
         if c.camera_rate_hz == 0:
             return
-        self._now = now
+        self._now, self._alive = now, node.context.ok
         self._info = camera_info(c.camera_width, c.camera_height, c.camera_fov_deg)
         self._image = node.create_publisher(Image, "~/camera/image_raw", 2)
         self._info_pub = node.create_publisher(CameraInfo, "~/camera/camera_info", 2)
         self._static = static_tf_publisher(node)
         self._static.publish(TFMessage(transforms=[
             link_transform(now(), optical_frame(c.camera_eye, c.camera_target))]))
+        spawn = multiprocessing.get_context("spawn")
+        requests, self._requests = spawn.Pipe(duplex=False)
+        self._frames, frames = spawn.Pipe(duplex=False)
+        spawn.Process(target=render_frames, name="acti-camera", daemon=True,
+                      args=(requests, frames, executor.world.urdf_path, c)).start()
+        requests.close()
+        frames.close()
+        self._stamp: Any = None                 # of the frame being rendered; None: idle
+        threading.Thread(target=self._publish_frames, name="acti-camera-publish",
+                         daemon=True).start()
         rate = 1.0 / executor.dt
-        executor.after_step(self._publish, every=max(1, round(rate / c.camera_rate_hz)))
+        executor.after_step(self._ask, every=max(1, round(rate / c.camera_rate_hz)))
 
-    def _publish(self, world: World) -> None:
+    def _ask(self, world: World) -> None:
+        """Simulation thread: hand the renderer this instant, unless it is still busy."""
+        if self._stamp is None:
+            self._stamp = self._now()
+            self._requests.send(world.placement())
+
+    def _publish_frames(self) -> None:
         c = self.config
-        rgb = world.render(c.camera_eye, c.camera_target, c.camera_fov_deg,
-                           c.camera_width, c.camera_height)
-        stamp = self._now()
-        image = Image(height=c.camera_height, width=c.camera_width, encoding="rgb8",
-                      step=3 * c.camera_width, data=rgb.tobytes())
-        image.header.stamp = self._info.header.stamp = stamp
-        image.header.frame_id = OPTICAL_FRAME
-        self._image.publish(image)
-        self._info_pub.publish(self._info)
+        while True:
+            try:
+                rgb = self._frames.recv_bytes()
+            except (EOFError, OSError):
+                return
+            image = Image(height=c.camera_height, width=c.camera_width, encoding="rgb8",
+                          step=3 * c.camera_width, data=rgb)
+            image.header.stamp = self._info.header.stamp = self._stamp
+            image.header.frame_id = OPTICAL_FRAME
+            self._stamp = None
+            try:
+                self._image.publish(image)
+                self._info_pub.publish(self._info)
+            except Exception:
+                if self._alive():
+                    raise
+                return

@@ -100,6 +100,19 @@ class World:
                                 renderer=pybullet.ER_TINY_RENDERER)[2]
         return np.asarray(rgba, np.uint8).reshape(height, width, 4)[:, :, :3]
 
+    def placement(self) -> tuple[tuple[float, ...], tuple[float, ...], list[float]]:
+        """Base position, base orientation (quaternion x, y, z, w) and the movable joints'
+        positions: what a copy of this world needs to look the same (`show`)."""
+        pos, orn = self._p.getBasePositionAndOrientation(self.robot)
+        return pos, orn, [s[0] for s in self._p.getJointStates(self.robot, self._movable)]
+
+    def show(self, placement: tuple[tuple[float, ...], tuple[float, ...], list[float]]) -> None:
+        """Put the robot where `placement` (of another world) has it: for rendering a copy."""
+        pos, orn, joints = placement
+        self._p.resetBasePositionAndOrientation(self.robot, pos, orn)
+        for j, q in zip(self._movable, joints):
+            self._p.resetJointState(self.robot, j, q)
+
     def joint_states(self) -> tuple[list[str], list[float], list[float]]:
         """Names, positions and velocities of every movable joint (rad, m; rad/s, m/s)."""
         states = self._p.getJointStates(self.robot, self._movable)
