@@ -41,8 +41,8 @@ class CameraConfig:
     camera_width: int = 320            # image width [px]
     camera_height: int = 240           # image height [px]
     camera_fov_deg: float = 60.0       # vertical field of view [degree]
-    camera_eye: tuple[float, ...] = (1.8, -1.4, 1.4)      # camera position in odom (the world at start) [m]
-    camera_target: tuple[float, ...] = (0.35, 0.0, 0.55)  # the point it looks at, in odom [m]
+    camera_eye: tuple[float, ...] = (1.6, -1.3, 1.2)      # camera position in odom (the world at start) [m]
+    camera_target: tuple[float, ...] = (0.2, 0.0, 0.65)   # the point it looks at, in odom [m]
 
 
 def check_camera(c: CameraConfig) -> None:
