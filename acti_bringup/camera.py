@@ -59,7 +59,8 @@ def check_camera(c: CameraConfig) -> None:
         raise ValueError("camera_eye and camera_target are x, y, z")
     view = np.subtract(c.camera_target, c.camera_eye)
     if np.linalg.norm(np.cross(view, [0.0, 0.0, 1.0])) < 1e-6 * max(1.0, np.linalg.norm(view)):
-        raise ValueError("camera_target must not be straight above or below camera_eye")
+        raise ValueError("camera_target must differ from camera_eye, and not be straight above "
+                         "or below it")
 
 
 def optical_frame(eye: tuple[float, ...], target: tuple[float, ...]) -> LinkTransform:

@@ -98,6 +98,8 @@ class VehicleNode(Node):
         serve_operations(self, self.core, OPERATIONS, write_success)
         self.wait_motion = WaitMotionServer(self, self.core, declare_config(self, WaitConfig))
         self.frames = declare_config(self, FrameConfig)
+        if self.frames.position_frame in ("", "odom", "base_link"):
+            raise ValueError("position_frame must name a frame of its own, not odom or base_link")
         self._odom = self.create_publisher(Odometry, "odom", 10)
         self._tf = tf_publisher(self) if self.frames.odom_tf else None
         self._truth = self.create_publisher(Odometry, "~/ground_truth", 10)
