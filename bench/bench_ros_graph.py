@@ -1,13 +1,16 @@
 """What the ROS-graph topics cost the simulation: the main job run as fast as it can
-(real_time_factor 0), its real-time factor read off /clock, and at real time (1.0) its CPU use,
-with the links' TF off and on and the camera off and on (two sizes, two rates). CPU counts
-the render process too."""
+(real_time_factor 0), its real-time factor read off /clock, and at real time (1.0) its CPU use
+and the `get_state` round trip (p99: the control plane must not wait for a frame), with the
+links' TF off and on and the camera off and on (two sizes, two rates). CPU counts the render
+process too."""
 from __future__ import annotations
 
 import os
 import time
 
-from common import RosClient, running
+import numpy as np
+from acti_msgs.srv import GetState
+from common import RosClient, latencies, running
 
 from rosgraph_msgs.msg import Clock
 from rclpy.qos import QoSProfile
@@ -62,13 +65,17 @@ def measure(ros: RosClient, pid: int) -> tuple[float, float]:
 def main() -> None:
     ros = RosClient()
     try:
-        print(f"{'case':<36} {'RTF, as fast as it can':>24} {'CPU at real time':>18}")
+        print(f"{'case':<36} {'RTF, as fast as it can':>24} {'at real time: CPU':>18}"
+              f" {'get_state p50 / p99':>22}")
         for name, params in CASES:
             with running("acti_bringup", "real_time_factor:=0.0", *params) as node:
                 fastest, _ = measure(ros, node.proc.pid)
             with running("acti_bringup", "real_time_factor:=1.0", *params) as node:
                 rtf, cpu = measure(ros, node.proc.pid)
-            print(f"{name:<36} {fastest:>22.2f} × {100 * cpu:>15.0f} %   (RTF {rtf:.3f})")
+                trips = latencies(lambda: ros.call(GetState, "/acti_middle_node/get_state"), 300)
+            p50, p99 = np.percentile(trips, [50, 99]) * 1e3
+            print(f"{name:<36} {fastest:>22.2f} × {100 * cpu:>15.0f} %"
+                  f" {p50:>10.1f} / {p99:5.1f} ms   (RTF {rtf:.3f})")
     finally:
         ros.close()
 
