@@ -112,7 +112,7 @@ class SimCamera:
         check_camera(c)
         if c.camera_rate_hz == 0:
             return
-        self._now, self._alive = now, node.context.ok
+        self._now, self._executor, self._log = now, executor, node.get_logger()
         self._info = camera_info(c.camera_width, c.camera_height, c.camera_fov_deg)
         self._image = node.create_publisher(Image, "~/camera/image_raw", 2)
         self._info_pub = node.create_publisher(CameraInfo, "~/camera/camera_info", 2)
@@ -133,12 +133,22 @@ class SimCamera:
         executor.after_step(self._ask, every=max(1, round(rate / c.camera_rate_hz)))
 
     def _ask(self, world: World) -> None:
-        """Simulation thread: hand the renderer this instant, unless it is still busy."""
+        """Simulation thread: hand the renderer this instant, unless it is still busy (or gone)."""
         if self._stamp is None:
             self._stamp = self._now()
-            self._requests.send(world.placement())
+            try:
+                self._requests.send(world.placement())
+            except OSError:
+                pass                                # gone: _publish_frames says so
 
     def _publish_frames(self) -> None:
+        """Receive and publish frames until the render process ends."""
+        self._publish_until_the_renderer_ends()
+        self._stamp = "gone"                        # ask no more
+        if self._executor.running:
+            self._log.error("camera: the render process ended; no more images")
+
+    def _publish_until_the_renderer_ends(self) -> None:
         c = self.config
         while True:
             try:
@@ -150,10 +160,7 @@ class SimCamera:
             image.header.stamp = self._info.header.stamp = self._stamp
             image.header.frame_id = OPTICAL_FRAME
             self._stamp = None
-            try:
-                self._image.publish(image)
-                self._info_pub.publish(self._info)
-            except Exception:
-                if self._alive():
-                    raise
+            if not self._executor.running:          # the host is shutting down
                 return
+            self._image.publish(image)
+            self._info_pub.publish(self._info)
