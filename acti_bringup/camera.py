@@ -37,7 +37,7 @@ MAX_PIXELS = 1920 * 1080
 
 @dataclass
 class CameraConfig:
-    camera_rate_hz: float = 0.0        # images per second of simulated time on ~/camera/image_raw; 0: no camera (rendering takes simulation time)
+    camera_rate_hz: float = 0.0        # images per second of simulated time on ~/camera/image_raw; 0: no camera (rendering costs CPU)
     camera_width: int = 320            # image width [px]
     camera_height: int = 240           # image height [px]
     camera_fov_deg: float = 60.0       # vertical field of view [degree]

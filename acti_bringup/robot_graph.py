@@ -33,8 +33,9 @@ class RobotGraph:
         self._now = now
         urdf_path = executor.world.urdf_path
         with open(urdf_path) as f:
-            self._description = node.create_publisher(String, "robot_description", LATCHED_QOS)
-            self._description.publish(String(data=f.read()))
+            urdf = f.read()
+        self._description = node.create_publisher(String, "robot_description", LATCHED_QOS)
+        self._description.publish(String(data=urdf))
         if not self.config.link_tf:
             return
         self.links = LinkPoses(urdf_path)
