@@ -19,9 +19,10 @@ $(DEPS_STAMP): requirements.txt requirements.lock tools/fix_cmake_paths.py
 	$(PY) tools/fix_cmake_paths.py $(VENV)
 	touch $@
 
-# Python sources need no rebuild: --symlink-install runs them from the tree.
-$(BUILD_STAMP): $(DEPS_STAMP) $(INTERFACES) package.xml setup.py setup.cfg
-	$(ENV) && colcon --log-base log build $(COLCON_PATHS) --symlink-install \
+# Python sources need no rebuild: --symlink-install runs them from the tree. Our tf2_msgs
+# (msg_defs/tf2_msgs) is added only where no tf2_msgs is installed (tools/own_tf2_msgs.py).
+$(BUILD_STAMP): $(DEPS_STAMP) $(INTERFACES) package.xml setup.py setup.cfg tools/own_tf2_msgs.py
+	$(ENV) && colcon --log-base log build $(COLCON_PATHS) $$(python tools/own_tf2_msgs.py) --symlink-install \
 	  --cmake-args -DBUILD_TESTING=OFF -DPython3_EXECUTABLE=$(abspath $(PY))
 	touch $@
 

@@ -1,5 +1,6 @@
 """The simulation a process hosts: one PyBullet world and one motion-queue executor, with the
-topics that belong to the world as a whole (/clock and joint_states)."""
+topics that belong to the world as a whole (/clock, joint_states, robot_description, the links'
+TF and the camera)."""
 from __future__ import annotations
 
 import sys
@@ -12,7 +13,9 @@ from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
+from acti_bringup.camera import SimCamera
 from acti_bringup.parameters import declare_config
+from acti_bringup.robot_graph import RobotGraph
 from acti_motion.executor import MotionExecutor
 from acti_sim.world import World
 
@@ -46,8 +49,10 @@ class Simulation:
         self._clock = node.create_publisher(Clock, "/clock", 10)
         self._joints = node.create_publisher(JointState, "joint_states", 10)
         self.executor.after_step(self._publish_clock)
-        self.executor.after_step(self._publish_joint_states,
-                                 every=max(1, round(c.rate_hz / c.joint_state_rate_hz)))
+        joint_state_every = max(1, round(c.rate_hz / c.joint_state_rate_hz))
+        self.executor.after_step(self._publish_joint_states, every=joint_state_every)
+        self.graph = RobotGraph(node, self.executor, joint_state_every, self.now)
+        self.camera = SimCamera(node, self.executor, self.now)
 
     def now(self) -> Time:
         return stamp(self.world.time)

@@ -37,7 +37,8 @@ class ProgramAction:
         self.server = ActionServer(node, RunProgram, "~/run_program", self._execute,
                                    callback_group=group, goal_callback=self._admit,
                                    cancel_callback=self._cancel)
-        node.context.on_shutdown(lambda: self._cancel(None))    # the node stops: so does the run
+        # the node stops: so does the run. A method: rclpy calls what a plain function returns
+        node.context.on_shutdown(self._on_shutdown)
 
     def _admit(self, _goal: Any) -> GoalResponse:
         with self._lock:
@@ -46,6 +47,9 @@ class ProgramAction:
                 return GoalResponse.REJECT
             self._busy = True
             return GoalResponse.ACCEPT
+
+    def _on_shutdown(self) -> None:
+        self._cancel(None)
 
     def _cancel(self, _goal: Any) -> CancelResponse:
         """At once: the program's waits end and the arm starts to decelerate now."""

@@ -370,6 +370,11 @@ class MotionExecutor:
             if self.steps % every == 0:
                 fn(world)
 
+    @property
+    def running(self) -> bool:
+        """Between start and shutdown, while the host process still runs."""
+        return self._running.is_set() and self._alive()
+
     def start(self) -> None:
         self._running.set()
         self._thread = threading.Thread(target=self._loop, name="acti-sim", daemon=True)

@@ -38,6 +38,7 @@ class World:
     def __init__(self, time_step: float = 1.0 / 240.0, urdf_path: str = URDF_PATH) -> None:
         self.time_step = time_step
         self.time = 0.0
+        self.urdf_path = urdf_path
         self._p = bullet_client.BulletClient(connection_mode=pybullet.DIRECT)
         p = self._p
         p.setAdditionalSearchPath(pybullet_data.getDataPath())
@@ -87,6 +88,30 @@ class World:
     def step(self) -> None:
         self._p.stepSimulation()
         self.time += self.time_step
+
+    def render(self, eye: tuple[float, float, float], target: tuple[float, float, float],
+               fov_deg: float, width: int, height: int) -> np.ndarray:
+        """An RGB image (height × width × 3, uint8) from a pinhole camera at `eye` looking at
+        `target` (z up), by PyBullet's CPU renderer: some milliseconds, so call it seldom."""
+        p = self._p
+        view = p.computeViewMatrix(eye, target, [0.0, 0.0, 1.0])
+        projection = p.computeProjectionMatrixFOV(fov_deg, width / height, 0.05, 30.0)
+        rgba = p.getCameraImage(width, height, view, projection,
+                                renderer=pybullet.ER_TINY_RENDERER)[2]
+        return np.asarray(rgba, np.uint8).reshape(height, width, 4)[:, :, :3]
+
+    def placement(self) -> tuple[tuple[float, ...], tuple[float, ...], list[float]]:
+        """Base position, base orientation (quaternion x, y, z, w) and the movable joints'
+        positions: what a copy of this world needs to look the same (`show`)."""
+        pos, orn = self._p.getBasePositionAndOrientation(self.robot)
+        return pos, orn, [s[0] for s in self._p.getJointStates(self.robot, self._movable)]
+
+    def show(self, placement: tuple[tuple[float, ...], tuple[float, ...], list[float]]) -> None:
+        """Put the robot where `placement` (of another world) has it: for rendering a copy."""
+        pos, orn, joints = placement
+        self._p.resetBasePositionAndOrientation(self.robot, pos, orn)
+        for j, q in zip(self._movable, joints):
+            self._p.resetJointState(self.robot, j, q)
 
     def joint_states(self) -> tuple[list[str], list[float], list[float]]:
         """Names, positions and velocities of every movable joint (rad, m; rad/s, m/s)."""

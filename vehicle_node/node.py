@@ -2,7 +2,8 @@
 
 Services: one per IDL operation (operations.py). Action: ~/wait_motion (actions.py).
 Topics (REP 103: m, rad):
-  odom (nav_msgs/Odometry)            wheel odometry, odom → base_link, 50 Hz
+  odom (nav_msgs/Odometry)            wheel odometry, odom → base_link, 50 Hz, with covariances
+  /tf (tf2_msgs/TFMessage)            odom → base_link and position_frame → odom, 50 Hz
   ~/ground_truth (nav_msgs/Odometry)  the simulator's true pose of base_link in the world, 50 Hz
   ~/state (acti_msgs/VehicleStatus)   state code and string of table 7 and what makes it, 10 Hz
   /diagnostics (DiagnosticArray)      battery and alarms, 1 Hz
@@ -12,6 +13,7 @@ Topics (REP 103: m, rad):
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 from acti_msgs.msg import VehicleStatus
@@ -20,11 +22,13 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from sensor_msgs.msg import Joy
+from tf2_msgs.msg import TFMessage
 
 from acti_bringup.adapter import serve_operations
 from acti_bringup.parameters import declare_config
 from acti_bringup.simulation import Simulation
-from acti_motion.vehicle.paths import Pose2D
+from acti_bringup.transforms import planar_transform, tf_publisher
+from acti_motion.vehicle.paths import Odometry as WheelOdometry, Pose2D
 from acti_motion.replies import Reply
 from acti_motion.vehicle.core import VehicleConfig, VehicleCore
 from acti_motion.vehicle.alarms import AlarmType
@@ -35,6 +39,15 @@ from vehicle_node.operations import OPERATIONS
 ODOM_RATE_HZ = 50.0
 STATE_RATE_HZ = 10.0
 DIAGNOSTICS_RATE_HZ = 1.0
+# The floor is flat: z, roll and pitch are known to 1 mm / 1 mrad, their rates to 1 mm/s, 1 mrad/s;
+# a wheel's sideways slip to 1 mm/s. x, y, yaw and the forward and yaw rates come from the wheels.
+PLANAR_VARIANCE = 1e-6
+
+
+@dataclass
+class FrameConfig:
+    position_frame: str = "map"    # frame of the spec's position (get/set_position); position_frame → odom on /tf is what set_position redefined (rename it if a localizer publishes map → odom)
+    odom_tf: bool = True           # publish odom → base_link and position_frame → odom on /tf (false when another node, e.g. a filter, publishes them)
 
 
 def write_success(response: Any, reply: Reply) -> None:
@@ -43,6 +56,7 @@ def write_success(response: Any, reply: Reply) -> None:
 
 
 def odometry_message(stamp: Any, frame: str, pose: Pose2D, v: float, w: float) -> Odometry:
+    """An Odometry of base_link without covariances (the ground truth)."""
     msg = Odometry()
     msg.header.stamp = stamp
     msg.header.frame_id = frame
@@ -55,6 +69,25 @@ def odometry_message(stamp: Any, frame: str, pose: Pose2D, v: float, w: float) -
     return msg
 
 
+def wheel_odometry_message(stamp: Any, pose: Pose2D, odo: WheelOdometry) -> Odometry:
+    """The continuous dead reckoning in `odom`, with its covariances (row-major 6×6 of x, y, z,
+    roll, pitch, yaw; for the twist: of vx, vy, vz and the three rates)."""
+    msg = odometry_message(stamp, "odom", pose, odo.v, odo.w)
+    pose_cov = [0.0] * 36
+    for (i, j), value in zip(((0, 0), (0, 1), (0, 5), (1, 1), (1, 5), (5, 5)),
+                             odo.covariance[[0, 0, 0, 1, 1, 2], [0, 1, 2, 1, 2, 2]]):
+        pose_cov[6 * i + j] = pose_cov[6 * j + i] = float(value)
+    for k in (2, 3, 4):
+        pose_cov[7 * k] = PLANAR_VARIANCE
+    var_v, var_w = odo.twist_variance
+    twist_cov = [0.0] * 36
+    twist_cov[0], twist_cov[35] = var_v + PLANAR_VARIANCE, var_w + PLANAR_VARIANCE
+    for k in (1, 2, 3, 4):
+        twist_cov[7 * k] = PLANAR_VARIANCE
+    msg.pose.covariance, msg.twist.covariance = pose_cov, twist_cov
+    return msg
+
+
 class VehicleNode(Node):
     """`vehicle_node`: hosts its own simulation unless given a shared one."""
 
@@ -64,7 +97,11 @@ class VehicleNode(Node):
         self.core = VehicleCore(self.simulation.executor, declare_config(self, VehicleConfig))
         serve_operations(self, self.core, OPERATIONS, write_success)
         self.wait_motion = WaitMotionServer(self, self.core, declare_config(self, WaitConfig))
+        self.frames = declare_config(self, FrameConfig)
+        if self.frames.position_frame in ("", "odom", "base_link"):
+            raise ValueError("position_frame must name a frame of its own, not odom or base_link")
         self._odom = self.create_publisher(Odometry, "odom", 10)
+        self._tf = tf_publisher(self) if self.frames.odom_tf else None
         self._truth = self.create_publisher(Odometry, "~/ground_truth", 10)
         self._state = self.create_publisher(VehicleStatus, "~/state", 10)
         self._diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
@@ -89,7 +126,12 @@ class VehicleNode(Node):
     # --- topics out (simulation thread) -------------------------------------------------------
     def _publish_odometry(self, world: World) -> None:
         odo, stamp = self.core.odometry, self.simulation.now()
-        self._odom.publish(odometry_message(stamp, "odom", odo.pose, odo.v, odo.w))
+        pose, frame = odo.continuous()
+        self._odom.publish(wheel_odometry_message(stamp, pose, odo))
+        if self._tf is not None:
+            self._tf.publish(TFMessage(transforms=[
+                planar_transform(stamp, "odom", "base_link", pose),
+                planar_transform(stamp, self.frames.position_frame, "odom", frame)]))
         v, w = world.base_twist()
         self._truth.publish(odometry_message(stamp, "world", Pose2D(*world.base_pose()), v, w))
 
