@@ -25,9 +25,9 @@ from acti_motion.vehicle.paths import (Chain, CurvePath, Odometry, Path, Pose2D,
 
 # Every plan's cost is bounded by these caps, whatever the path's length or the speed settings.
 SAMPLE_DT = 0.005            # s between samples of the timed path …
-SAMPLES_MAX = 20000          # … at most this many (a slower path is sampled coarser)
+SAMPLES_MAX = 8000           # … at most this many (a slower path is sampled coarser)
 DENSE_STEP = 0.002           # m between samples of the geometric path …
-DENSE_MAX = 20000            # … at most this many
+DENSE_MAX = 10000            # … at most this many
 SPLINE_KEEP = 2000           # samples of it handed to TOPP-RA's interpolator
 GRID_STEP = 0.01             # m between TOPP-RA grid points …
 GRID_MAX = 600               # … at most this many
@@ -103,8 +103,19 @@ def plan_curve(start: Pose2D, points: Sequence[tuple[float, float]],
                w0: float = 0.0) -> CurvePlan | None:
     """The timed smooth path from `start` (moving forward at v0, turning at w0) through
     `points` to rest at the last; None when there is nothing to do or TOPP-RA finds no
-    feasible timing."""
-    geometry = spline_through(start, points, w0 / v0 if v0 > 1e-6 else 0.0)
+    feasible timing. The path starts with the curvature of (v0, w0) where a timing exists,
+    else straight (the yaw rate then changes at once, as little as the geometry allows)."""
+    w0 = min(max(w0, -0.999 * limits[1]), 0.999 * limits[1])
+    plan = _plan_curve(start, points, limits, v0, w0 / v0 if v0 > 1e-6 else 0.0)
+    if plan is None and w0 != 0.0 and v0 > 1e-6:
+        plan = _plan_curve(start, points, limits, v0, 0.0)
+    return plan
+
+
+def _plan_curve(start: Pose2D, points: Sequence[tuple[float, float]],
+                limits: tuple[float, float, float, float], v0: float,
+                curvature: float) -> CurvePlan | None:
+    geometry = spline_through(start, points, curvature)
     if geometry is None:
         return None
     s, x, y, heading, s_points = geometry
