@@ -3,6 +3,7 @@ nothing can move is ignored, clear_alarm clears all, a blocked move ends Stuck (
 battery alarms have hysteresis, and absurd inputs are refused without touching the queue, with
 every plan's cost bounded."""
 import math
+import threading
 import time
 
 import pytest
@@ -39,17 +40,23 @@ def test_a_paused_jog_resumed_after_its_timeout_does_not_drive_again(base, execu
     assert math.dist(position(base)[:2], held[:2]) < 2.0        # not another 100 mm
 
 
-def test_the_deadman_counts_wall_time_since_the_last_call(base, executor):  # noqa: F811
-    """Repeated calls keep the jog going; once they stop it ends within the timeout of wall
-    time, whatever the simulated time did meanwhile."""
+def test_the_deadman_counts_wall_time_since_the_last_call(base, executor, trace):  # noqa: F811
+    """A simulation slower than the wall clock (here: not stepped at all) does not extend a jog:
+    once the timeout has passed in wall time, the next control period brakes it."""
     ready(base)
+    base.set_acceleration((1000.0, 180.0))
     base.set_jog_timeout(200)
-    for _ in range(5):
-        assert base.move_jog(200.0, 0.0, 0.0).ok
-        steps(executor, 0.05)
-    last_call = time.monotonic()
-    run_until(executor, lambda: base.device.current is None or base._deadman_fired, 30.0)
-    assert time.monotonic() - last_call >= 0.2 or base.device.t >= 0.2
+    motion = base.move_jog(300.0, 0.0, 0.0).values["motion_id"]
+    trace.step(0.1)                                          # 0.1 s of path time
+    deadline = base._drive_deadline
+    while time.monotonic() <= deadline:                      # wall time passes, the world waits
+        threading.Event().wait(0.01)
+    speed = trace.points[-1].v
+    trace.step(0.05)
+    assert base._deadman_fired == motion and base.device.t < 0.2
+    assert trace.points[-1].v < speed - 0.02                 # braking, 0.1 s before the path's hold
+    trace.until_idle(2.0)
+    trace.check()
 
 
 # --- pause where nothing moves ------------------------------------------------------------
