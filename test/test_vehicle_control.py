@@ -105,16 +105,16 @@ def test_moves_sent_during_the_stops_deceleration_are_discarded(base, executor, 
 # --- planning never blocks the control plane ------------------------------------------------
 @pytest.fixture
 def planning_gate(monkeypatch):
-    """Holds every cruise plan (the real one runs after the gate opens) so the test can act while
-    another thread is planning."""
+    """Holds every TOPP-RA timing (the real one runs after the gate opens) so the test can act
+    while another thread is planning."""
     entered, gate = threading.Event(), threading.Event()
-    real = cruise.plan_curve
+    real = cruise.time_optimal
 
     def gated(*args, **kwargs):
         entered.set()
         assert gate.wait(10.0)
         return real(*args, **kwargs)
-    monkeypatch.setattr(cruise, "plan_curve", gated)
+    monkeypatch.setattr(cruise, "time_optimal", gated)
     yield entered, gate
     gate.set()
 

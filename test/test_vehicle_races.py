@@ -197,8 +197,8 @@ def test_the_work_area_is_a_setting(executor):  # noqa: F811
 
 
 def test_cruise_points_added_one_by_one_plan_a_window_of_constant_size(base, executor, monkeypatch):  # noqa: F811
-    """Adding the n-th point re-plans at most the last two points and the new one, so n points
-    cost n times one (it was n²)."""
+    """Adding the n-th point re-plans at most the last WINDOW points and the new one, so n
+    points cost n times one (it was n²)."""
     sizes = []
     real = cruise.plan_curve
 
@@ -209,8 +209,8 @@ def test_cruise_points_added_one_by_one_plan_a_window_of_constant_size(base, exe
     ready(base)
     for i in range(40):
         assert base.move_cruise_abs((400.0 * (i + 1), 300.0 * (i % 2))).values["motion_id"] == 1
-    assert max(sizes[1:]) <= 3 and len(sizes) == 40
+    assert max(sizes[cruise.WINDOW:]) <= cruise.WINDOW + 1 and len(sizes) == 40
     steps(executor, 3.0)                                         # and while it runs
     for i in range(40, 50):
         assert base.move_cruise_abs((400.0 * (i + 1), 300.0 * (i % 2))).values["motion_id"] == 1
-    assert max(sizes[1:]) <= 3
+    assert max(sizes[cruise.WINDOW:]) <= cruise.WINDOW + 1

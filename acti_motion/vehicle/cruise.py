@@ -32,6 +32,9 @@ SPLINE_KEEP = 2000           # samples of it handed to TOPP-RA's interpolator
 GRID_STEP = 0.01             # m between TOPP-RA grid points …
 GRID_MAX = 600               # … at most this many
 MIN_SEPARATION = 1e-3        # m: closer points are one point
+WINDOW = 2                   # points before a new cruise point that are planned again with it
+LET_DOWN = 0.8               # a start above v_max is let down at this share of a_max (slack for TOPP-RA)
+RETIME_SAMPLES = 400         # samples of the rest of a cruise path timed again (more: a noisier heading)
 
 logging.getLogger("toppra").setLevel(logging.ERROR)   # an infeasible start is handled here
 
@@ -46,7 +49,7 @@ class CurvePlan:
 def time_optimal(s: np.ndarray, heading: np.ndarray, limits: tuple[float, float, float, float],
                  v0: float = 0.0, grid_step: float = GRID_STEP, grid_max: int = GRID_MAX):
     """TOPP-RA over the path (s, theta(s)) with the drive's bounds, from speed v0 to rest.
-    A start faster than v_max (the velocity setting was lowered) is let down at a_max.
+    A start faster than v_max (the velocity setting was lowered) is let down at LET_DOWN · a_max.
     The trajectory (callable t → [s, theta], and its derivatives), or None when infeasible."""
     ta = toppra
     v_max, w_max, a_max, alpha_max = limits
@@ -55,7 +58,7 @@ def time_optimal(s: np.ndarray, heading: np.ndarray, limits: tuple[float, float,
     n = int(min(grid_max, max(20, math.ceil(s[-1] / grid_step))))
     if v0 > v_max:
         def bounds(si: float) -> np.ndarray:
-            v = max(v_max, math.sqrt(max(0.0, v0 * v0 - 2.0 * a_max * si))) * (1 + 1e-6)
+            v = max(v_max, math.sqrt(max(0.0, v0 * v0 - 2.0 * LET_DOWN * a_max * si))) * (1 + 1e-6)
             w = w_max * v / v_max
             return np.array([[-v, v], [-w, w]])
         velocity = ta.constraint.JointVelocityConstraintVarying(bounds)
@@ -116,9 +119,14 @@ def _plan_curve(start: Pose2D, points: Sequence[tuple[float, float]],
                 limits: tuple[float, float, float, float], v0: float,
                 curvature: float) -> CurvePlan | None:
     geometry = spline_through(start, points, curvature)
-    if geometry is None:
-        return None
-    s, x, y, heading, s_points = geometry
+    return None if geometry is None else timed_path(*geometry, limits, v0)
+
+
+def timed_path(s: np.ndarray, x: np.ndarray, y: np.ndarray, heading: np.ndarray,
+               s_points: Sequence[float], limits: tuple[float, float, float, float],
+               v0: float) -> CurvePlan | None:
+    """The geometric path (arc length s, x, y, heading) timed by TOPP-RA from speed v0 to rest,
+    with the times at which it passes the arc lengths `s_points`."""
     trajectory = time_optimal(s, heading, limits, v0)
     if trajectory is None:
         return None
@@ -156,8 +164,8 @@ class CruiseMotion(TrackedBaseMotion):
     runs re-plans the rest of the path (speed continuous), so the base passes every point
     without stopping and stops only at the last. From rest it first turns toward the first
     point. Planning (`plan`) only reads the motion; `commit` installs a plan under the device's
-    lock. A point is added in constant time: only the path after the last point but one is
-    planned again (the base would have slowed down there for the stop at the last)."""
+    lock. A point is added in constant time: only the path after the point WINDOW before the
+    last is planned again."""
 
     def __init__(self, odometry: Odometry, start: Pose2D, point: tuple[float, float],
                  limits: tuple[float, float, float, float]) -> None:
@@ -184,9 +192,31 @@ class CruiseMotion(TrackedBaseMotion):
         self.splice(plan.at, plan.path)
 
     def replan(self, t: float, limits: tuple[float, float, float, float]) -> Callable[[], None] | None:
-        """New velocity or acceleration settings: the rest of the path re-planned from t."""
-        plan = self.plan(t, [], limits)
+        """New velocity or acceleration settings: the rest of the path timed again from t (its
+        geometry kept), or planned again while the base still turns toward the first point."""
+        plan = self._retimed(t, limits) or self.plan(t, [], limits)
         return None if plan is None else (lambda: self.commit(plan))
+
+    def _retimed(self, t: float, limits: tuple[float, float, float, float]) -> CruiseState | None:
+        st, path = self.state, self.path
+        t = max(t, self.t0)
+        local = t - self.t0
+        ahead = self._ahead(local)
+        v0 = self.reference_twist(t)[0]
+        if (st.from_rest and local <= st.curve_from) or not ahead or v0 <= 1e-4:
+            return None
+        times = np.linspace(local, path.duration, RETIME_SAMPLES)
+        poses = [path.pose(float(tau)) for tau in times]
+        xy = np.array([(p.x, p.y) for p in poses])
+        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
+        keep = np.concatenate([[True], np.diff(s) > 1e-7])
+        heading = np.array([p.theta for p in poses])
+        s_points = [float(np.interp(tp, times, s)) for _, tp in ahead]
+        plan = timed_path(s[keep], xy[keep, 0], xy[keep, 1], heading[keep], s_points, limits, v0)
+        if plan is None:
+            return None
+        return CruiseState(tuple(p for p, _ in ahead), tuple(plan.via_times), False, 0.0, limits, t,
+                           Chain([plan.path], poses[0]))
 
     def move_frame(self, frame: Pose2D) -> None:
         super().move_frame(frame)
@@ -199,22 +229,24 @@ class CruiseMotion(TrackedBaseMotion):
 
     def _plan_window(self, t: float, extra: list[tuple[float, float]],
                      limits: tuple[float, float, float, float]) -> CruiseState | None:
-        """Points added with unchanged limits: keep the path up to the last point but one and
-        plan only from there (through the last point and the new ones)."""
+        """Points added with unchanged limits: keep the path up to the point WINDOW before the
+        last and plan only from there (through the last WINDOW points and the new ones): far
+        enough back that the old stop at the last point barely slows the base there."""
         st, t0, path = self.state, self.t0, self.path
         ahead = self._ahead(t - t0)
-        if not extra or limits != st.limits or len(ahead) < 2 or not isinstance(path, Chain):
+        if not extra or limits != st.limits or len(ahead) <= WINDOW or not isinstance(path, Chain):
             return None
-        cut = ahead[-2][1]
+        cut = ahead[-WINDOW - 1][1]
         head = path.head(cut)
         v0, w0 = path.twist(cut)
         if head is None or v0 <= 1e-4:
             return None
-        plan = plan_curve(path.pose(cut), [ahead[-1][0]] + list(extra), limits, v0, w0)
+        again = [p for p, _ in ahead[-WINDOW:]]
+        plan = plan_curve(path.pose(cut), again + list(extra), limits, v0, w0)
         if plan is None:
             return None
         return CruiseState(tuple(p for p, _ in ahead) + tuple(extra),
-                           tuple(tp for _, tp in ahead[:-1]) + tuple(cut + v for v in plan.via_times),
+                           tuple(tp for _, tp in ahead[:-WINDOW]) + tuple(cut + v for v in plan.via_times),
                            st.from_rest, st.curve_from, limits, t0, Chain(head + [plan.path], path.start))
 
     def _plan_from(self, t: float, extra: list[tuple[float, float]],
