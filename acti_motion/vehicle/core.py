@@ -865,19 +865,26 @@ class VehicleCore:
         resume) at `accel` (mm/s², degree/s²). Speed = rate × path speed, so where the path
         itself slows down (or, ramping up, speeds up) just now, its own acceleration adds to the
         ramp's: the ramp takes only what is left of `accel` beside it (at least a quarter); and
-        a path that speeds up while it stops reaches a higher speed to take down."""
+        stopping takes down the highest speed the path reaches meanwhile."""
         device, dt = self.device, self._dt
         cur = device.current
         if cur is None or not hasattr(cur.motion, "reference_twist"):
-            now = later = (self.odometry.v, self.odometry.w)
+            def twist(_: float) -> tuple[float, float]:
+                return self.odometry.v, self.odometry.w
         else:
-            now, later = cur.motion.reference_twist(device.t), cur.motion.reference_twist(device.t + dt)
+            def twist(t: float) -> tuple[float, float]:
+                return cur.motion.reference_twist(t)
+        t = device.t
+        now, later = twist(t), twist(t + dt)
         ramp = 0.02
-        for speed, next_speed, a in zip(now, later, (accel[0] / 1000.0, math.radians(accel[1]))):
-            change = (abs(next_speed) - abs(speed)) / dt
+        for i, a in enumerate((accel[0] / 1000.0, math.radians(accel[1]))):
+            change = (abs(later[i]) - abs(now[i])) / dt
             adds = max(0.0, change if up else -change)
-            grows = 0.0 if up else max(0.0, change)        # the speed still rises while stopping
-            ramp = max(ramp, abs(speed) * (1.0 + grows / a) / max(a - adds, a / 4))
+            speed = abs(now[i])
+            if not up and change > 0.0:            # the path still speeds up while it stops
+                span = speed * (1.0 + change / a) / a
+                speed = max(abs(twist(t + span * k / 8)[i]) for k in range(9))
+            ramp = max(ramp, speed / max(a - adds, a / 4))
         return ramp
 
     def _stop_ramp(self) -> float:
