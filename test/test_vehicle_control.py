@@ -1,16 +1,14 @@
 """The base's control plane without ROS: pause, resume and stop checked set-point by set-point
 (trajectory_check_base), also in the window between accept and pick-up and while another thread
 plans; planning never holds a lock that stop, the getters or the simulation need."""
-import math
 import threading
 
 import pytest
 
 from acti_motion.vehicle import cruise
 from acti_motion.vehicle.core import VehicleState
-from acti_motion.vehicle.paths import Pose2D
-from sim_fixtures import executor, run_until  # noqa: F401
-from vehicle_fixtures import assert_at, base, position, ready, settle, state, steps, trace  # noqa: F401
+from sim_fixtures import executor  # noqa: F401
+from vehicle_fixtures import base, position, ready, state, trace  # noqa: F401
 
 MOVES = {
     "move_forward": lambda b: b.move_forward(1500.0),
@@ -20,11 +18,6 @@ MOVES = {
     "move_continuous_rel": lambda b: b.move_continuous_rel((1500.0, 300.0, 20.0)),
     "move_jog": lambda b: b.move_jog(400.0, 0.0, 20.0),
 }
-
-
-def setting(base):
-    (at, ar) = base.acceleration
-    return at / 1000.0, math.radians(ar)
 
 
 @pytest.mark.parametrize("move", sorted(MOVES))

@@ -581,7 +581,7 @@ class VehicleCore:
         limits, label = self._limits(), "move_continuous_rel"
 
         def look(device: Device, attempt: int):
-            cur = self._running(device, take_over=True)
+            cur = self._running(device)
             if cur is None:
                 return None
             return cur, cur.motion.at(device.t), self._splice_time(device, cur.motion, attempt)
@@ -733,7 +733,7 @@ class VehicleCore:
         return out
 
     @staticmethod
-    def _running(device: Device, take_over: bool) -> Any:
+    def _running(device: Device) -> Any:
         """The motion a jog or a continuous move would re-plan: the running tracked motion,
         unless a stop decelerates it (then a new motion is submitted, and discarded)."""
         cur = device.current
@@ -789,7 +789,7 @@ class VehicleCore:
         refused), or start one on an idle base. The deadman ends it `hold` s of wall time from
         now unless called again."""
         def look(device: Device, attempt: int):
-            cur = self._running(device, take_over)
+            cur = self._running(device)
             if not take_over and (device.queue or cur is not None and cur.label not in VELOCITY_DRIVEN):
                 raise self._busy(label)
             return None if cur is None else (cur, self._splice_time(device, cur.motion, attempt))
@@ -811,10 +811,9 @@ class VehicleCore:
         if motion_id is None and target == (0.0, 0.0):
             return {"motion_id": 0}                  # standing still already: nothing to queue
         if motion_id is None:
-            out = self._submit(lambda start: velocity_path(start, 0.0, 0.0, target, hold, accel),
-                               label, SERVO_ON)
-            self._arm_deadman(hold, target)
-            return out
+            self._arm_deadman(hold, target)          # before the simulation can pick it up
+            return self._submit(lambda start: velocity_path(start, 0.0, 0.0, target, hold, accel),
+                                label, SERVO_ON)
         self._accepted_motion()
         return {"motion_id": motion_id}
 
