@@ -8,20 +8,21 @@ mm/s, degree/s, mm/s², degree/s², ms; the motion layer below works in m, rad, 
 """
 from __future__ import annotations
 
-import functools
 import math
 import threading
 import time
-from dataclasses import dataclass
-from enum import IntEnum
 from typing import Any, Callable
 
 from acti_motion.executor import STALE, Device, MotionExecutor
-from acti_motion.replies import Refused, Reply, ReturnCode, answers, finite_number
+from acti_motion.replies import Refused, Reply, finite_number
 from acti_motion.vehicle.alarms import AlarmCode, Alarms, AlarmType, Kind
+from acti_motion.vehicle.config import VehicleConfig
 from acti_motion.vehicle.cruise import CruiseMotion, plan_curve, transition_to
 from acti_motion.vehicle.paths import (BrakeMotion, Chain, Odometry, Path, Pose2D, TrackedBaseMotion,
                                        arc, line, straight_to, turn, velocity_path)
+from acti_motion.vehicle.refusals import (Discarded, VehicleRefused, bounded_pair, command, finite_pose,
+                                          invalid, planned, query)
+from acti_motion.vehicle.states import IDLE, SERVO_ON, STATE_STRINGS, VehicleState
 from acti_sim.battery import Battery, BatteryModel, VoltageLevel
 from acti_sim.io_module import IoModule
 from acti_sim.world import World
@@ -31,151 +32,10 @@ FIRMWARE_VERSION = "Ver.1.0.0.1"
 WHEEL_AXES = (0, 1)                      # getServoStatus ids: left, right wheel motor
 VELOCITY_DRIVEN = ("move_jog", "joystick")  # motions driven by a velocity, not a target
 
-
-class VehicleState(IntEnum):
-    """Table 7 of the VehicleService spec: state code → the state string's stem."""
-    READY = 0x010
-    BUSY = 0x011
-    WARNING = 0x012
-    ALARM = 0x013
-    STUCK = 0x014
-    PAUSED = 0x015
-    AVOID = 0x016
-    LOCKED = 0x017
-    POWERED = 0x018
-    UNPOWERED = 0x019
-
-
-STATE_STRINGS = {
-    VehicleState.READY: "Ready", VehicleState.BUSY: "Busy", VehicleState.WARNING: "Warning",
-    VehicleState.ALARM: "Alarm", VehicleState.STUCK: "Stuck", VehicleState.PAUSED: "Paused",
-    VehicleState.AVOID: "Avoid", VehicleState.LOCKED: "Locked", VehicleState.POWERED: "Powered",
-    VehicleState.UNPOWERED: "Unpowered",
-}
-# "Ready only" moves (moveForward, moveTurn, moveLinearRel, moveCircularRel) run from an idle base;
-# Paused is idle too, and the pause operation says commands given then are kept for resume.
-IDLE = (VehicleState.READY, VehicleState.WARNING, VehicleState.STUCK, VehicleState.PAUSED)
-# "Servo on only" moves (moveLinearAbs, moveContinuousRel, moveCruiseAbs, moveJog) also queue
-# behind a moving base; Alarm and Locked refuse every motion until clearAlarm / unlock.
-SERVO_ON = IDLE + (VehicleState.BUSY, VehicleState.AVOID)
-
-
-@dataclass
-class VehicleConfig:
-    """Start-up settings and limits of the base (spec units); the node's parameters."""
-    queue_size: int = 32
-    velocity_limit_translation: float = 1000.0   # mm/s
-    velocity_limit_rotation: float = 90.0        # degree/s
-    accel_limit_translation: float = 1000.0      # mm/s²
-    accel_limit_rotation: float = 180.0          # degree/s²
-    velocity_min_translation: float = 1.0        # mm/s: the slowest velocity setting (set_velocity)
-    velocity_min_rotation: float = 0.1           # degree/s: the slowest yaw-rate setting
-    accel_min_translation: float = 1.0           # mm/s²: the lowest acceleration setting
-    accel_min_rotation: float = 1.0              # degree/s²: the lowest angular acceleration setting
-    default_velocity_translation: float = 300.0
-    default_velocity_rotation: float = 45.0
-    default_accel_translation: float = 500.0
-    default_accel_rotation: float = 90.0
-    work_area: float = 100000.0                  # mm: targets and set_position within ±this in x and y
-    turn_limit: float = 3600.0                   # degree: the largest rotation a move or set_position asks
-    jog_timeout: int = 500                       # ms
-    joy_axis_linear: int = 1                     # sensor_msgs/Joy axis for forward speed …
-    joy_axis_angular: int = 0                    # … and for the yaw rate (left stick)
-    joy_enable_button: int = -1                  # a button that must be held (-1: none)
-    io_config: str = ""                          # I/O ids (YAML); "" = config/vehicle_io.yaml
-    battery_capacity_wh: float = 960.0
-    battery_charge: float = 1.0                  # state of charge at start-up, 0 … 1
-    battery_low_voltage: float = 46.0            # V: warning 110 below
-    battery_cutoff_voltage: float = 44.0         # V: fault 201 below (servo off)
-    battery_hysteresis: float = 1.0              # V: a battery alarm's cause is gone this far above its level
-    stuck_error: float = 100.0                   # mm of tracking error …
-    stuck_angle: float = 20.0                    # … or degrees of heading error …
-    stuck_time: float = 0.3                      # … held this long (s): the base is Stuck
-    arrival_error: float = 20.0                  # mm: a move that ends farther from its target is Stuck …
-    arrival_angle: float = 3.0                   # … or more degrees off its heading
-
-
 POWER_IDLE_W = 30.0          # electronics while the main power is on
 POWER_SERVO_W = 20.0         # wheel servos holding
 DRIVE_LOSS_N = 150.0         # rolling and drive-train resistance of the moving base
 DRIVE_EFFICIENCY = 0.8
-
-
-class VehicleRefused(Refused):
-    """A refusal with the warning code it raises."""
-
-    def __init__(self, alarm: AlarmCode, comment: str) -> None:
-        super().__init__(ReturnCode.NG, comment)
-        self.alarm = alarm
-
-
-class Discarded(Refused):
-    """A move accepted while a stop decelerates: true, and discarded (stop: 停止後は全ての動作指令を廃棄)."""
-
-    def __init__(self, operation: str) -> None:
-        super().__init__(ReturnCode.OK, f"discarded: the base is stopping ({operation} given during "
-                                        "the stop's deceleration; stop discards every motion command)")
-
-
-WARNING_FOR = {ReturnCode.VALUE_ERR: AlarmCode.INVALID_VALUE,
-               ReturnCode.STATUS_ERR: AlarmCode.WRONG_STATE,
-               ReturnCode.FULL_MOTION_QUEUE_ERR: AlarmCode.QUEUE_FULL}
-
-
-def invalid(message: str) -> VehicleRefused:
-    return VehicleRefused(AlarmCode.INVALID_VALUE, message)
-
-
-def _operation(clears_warnings: bool, plans: bool = False) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
-    """An IDL operation: a refusal raises its warning, success clears the command warnings, and
-    any other failure is a refusal with a comment, never an exception. Control operations hold
-    the short state lock; planning operations (`plans`) hold only the planning lock, so that
-    stop, pause, the getters and the simulation never wait for a plan."""
-    def decorate(fn: Callable[..., Any]) -> Callable[..., Any]:
-        @functools.wraps(fn)
-        def recorded(self: "VehicleCore", *args: Any, **kwargs: Any) -> Any:
-            with (self.planning if plans else self.lock):
-                if plans:
-                    self._op_generation = self.device.generation
-                try:
-                    out = fn(self, *args, **kwargs)
-                except Refused as r:
-                    if r.code != ReturnCode.OK:
-                        code = getattr(r, "alarm", None) or WARNING_FOR.get(r.code, AlarmCode.INVALID_VALUE)
-                        self.alarms.raise_(code, f"{fn.__name__}: {r.comment}", Kind.COMMAND)
-                    raise
-                except (ArithmeticError, ValueError, TypeError, IndexError) as e:
-                    comment = f"{fn.__name__} could not be carried out ({type(e).__name__}: {e})"
-                    self.alarms.raise_(AlarmCode.INVALID_VALUE, comment, Kind.COMMAND)
-                    raise invalid(comment) from None
-                if clears_warnings:
-                    self.alarms.clear(Kind.COMMAND)
-                return out
-        return answers(recorded)
-    return decorate
-
-
-command = _operation(clears_warnings=True)    # changes something: success clears command warnings
-query = _operation(clears_warnings=False)     # reads: a refusal (unknown id) still warns
-planned = _operation(clears_warnings=True, plans=True)   # plans a motion or a new timing
-
-
-def bounded_pair(values: Any, lower: tuple[float, float], limits: tuple[float, float], name: str,
-                 unit: tuple[str, str]) -> tuple[float, float]:
-    """(translation, rotation), each finite and within [lower, limit]."""
-    out = []
-    for value, low, limit, part, u in zip(values, lower, limits, ("translation", "rotation"), unit):
-        v = finite_number(value, f"{name}.{part}")
-        if not low <= v <= limit:
-            raise invalid(f"{name}.{part} is {v:g} {u}: it must be within {low:g} … {limit:g} {u}")
-        out.append(v)
-    return out[0], out[1]
-
-
-def finite_pose(pos: Any, name: str = "pos") -> Pose2D:
-    """A Position (mm, mm, degree) as a Pose2D (m, m, rad)."""
-    x, y, theta = (finite_number(v, f"{name}.{f}") for v, f in zip(pos, ("x", "y", "theta")))
-    return Pose2D(x / 1000.0, y / 1000.0, math.radians(theta))
 
 
 LOOKAHEAD_STEPS = 2          # control periods ahead of now that an edit planned off-lock splices in …
