@@ -30,6 +30,9 @@ class Motion(Protocol):
         """The set-point at time t (the device's own kind: joint vector, pose …)."""
 
 
+STALE = object()       # Device.edit_planned: the plan came too late, plan again
+
+
 @dataclass
 class QueuedMotion:
     id: int
@@ -61,6 +64,7 @@ class Device:
         self._stop_at: float | None = None
         self.paused = False
         self.generation = 0
+        self.revision = 0          # bumped whenever the motions change, except by time passing
         self.last_id = 0
         self.retired_id = 0
         self.completed = 0
@@ -118,6 +122,7 @@ class Device:
                         if self._stop_at is None:
                             continue        # a halt's own motion runs: plan again from its end
                     self.last_id += 1
+                    self.revision += 1
                     self.queue.append(QueuedMotion(self.last_id, motion, label))
                     if self._stop_at is None:
                         self.queued_end = self._end_of_queue()
@@ -172,9 +177,45 @@ class Device:
         without racing the simulation; the queued end then follows the last motion."""
         with self.lock:
             out = fn(self)
+            self.revision += 1
             self.queued_end = self._end_of_queue()
             self.changed.notify_all()
             return out
+
+    def edit_planned(self, look: Callable[["Device", int], Any],
+                     plan: Callable[[Any], Callable[["Device"], Any]], tries: int = 6) -> Any:
+        """An edit whose planning runs under no lock, so the simulation never waits for it.
+
+        look(device, attempt) runs under the lock and takes what the plan needs (say, the
+        reference state a little ahead of now: the further the more attempts failed);
+        plan(seen) runs under no lock and returns commit(device), which runs under the lock
+        only if no motion was queued, started, finished, edited or stopped meanwhile, and may
+        itself answer STALE (the device has passed the planned splice time). Either way it
+        looks and plans again, at most `tries` times; then STALE. Callers serialise their own
+        planning (an edit or a stop that comes in meanwhile only costs a retry).
+        """
+        for attempt in range(tries):
+            with self.lock:
+                seen_at = (self.generation, self.revision)
+                seen = look(self, attempt)
+            commit = plan(seen)
+            with self.lock:
+                if seen_at != (self.generation, self.revision):
+                    continue
+                out = commit(self)
+                if out is STALE:
+                    continue
+                self.revision += 1
+                self.queued_end = self._end_of_queue()
+                self.changed.notify_all()
+                return out
+        return STALE
+
+    def discard_queue(self) -> None:
+        """Discard the queued motions (not the current one), for an edit that changes where the
+        current one ends; the lock must be held (call it from an edit)."""
+        self.generation += 1
+        self._retire_queue()
 
     def halt(self, rest: Any) -> None:
         """Discard the current motion and the queue at once and rest at `rest` (where the device
@@ -220,6 +261,7 @@ class Device:
                 if self.paused or not self.queue:
                     return
                 self.current = self.queue.popleft()
+                self.revision += 1
                 self.t = 0.0
                 self.changed.notify_all()
             t0 = self.t
@@ -285,6 +327,7 @@ class Device:
         else:
             self.completed += 1
         self.current = None
+        self.revision += 1
         self.changed.notify_all()
 
     def _end_of_queue(self) -> Any:

@@ -38,3 +38,23 @@ class Battery:
         """Deliver `power` W for `dt` s."""
         self.power = max(0.0, power)
         self.charge = max(0.0, self.charge - self.power * dt / (3600.0 * self.model.capacity_wh))
+
+
+class VoltageLevel:
+    """A voltage alarm level with hysteresis: tripped below `level`, released only at
+    `level + band` or above, so a load that drops (and lets the voltage recover a little)
+    does not end the alarm of a battery that is still at its limit."""
+
+    def __init__(self, level: float, band: float) -> None:
+        if band < 0:
+            raise ValueError(f"battery: the hysteresis band is {band} V, it must be >= 0")
+        self.level, self.band = level, band
+        self.tripped = False
+
+    def update(self, voltage: float) -> bool:
+        """Whether the level is tripped at this voltage."""
+        if voltage < self.level:
+            self.tripped = True
+        elif voltage >= self.level + self.band:
+            self.tripped = False
+        return self.tripped

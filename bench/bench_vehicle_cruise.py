@@ -1,10 +1,13 @@
 """moveCruiseAbs against the time-optimal bound: the same path (spline through the points) and
-limits, timed by TOPP-RA on a fine grid. Simulated seconds; no ROS (the core on its own world)."""
+limits, timed by TOPP-RA on a fine grid. Simulated seconds; no ROS (the core on its own world).
+Then the planning cost of adding points one by one (wall time per call, first and last tenth):
+flat when adding a point costs the same however many came before."""
 from __future__ import annotations
 
 import math
 import os
 import sys
+import threading
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -66,8 +69,84 @@ def main() -> None:
     print(f"  slowest between the first point and 100 mm before the last: {1000.0 * slowest:.0f} mm/s")
     print("  closest approach to each point (mm): " + ", ".join(f"{closest[p]:.2f}" for p in POINTS_MM))
     print(f"  planning per move_cruise_abs call (wall): mean {1000 * sum(wall) / len(wall):.1f} ms, "
-          f"max {1000 * max(wall):.1f} ms (first includes the toppra import)")
+          f"max {1000 * max(wall):.1f} ms (toppra is imported and warmed up at start-up)")
+
+
+def adding_points(n: int) -> None:
+    """Wall time of each of n move_cruise_abs calls on a queued cruise (a zig-zag, 0.4 m apart)."""
+    world = World()
+    base = VehicleCore(MotionExecutor(world, real_time_factor=0.0))
+    base.set_power(True)
+    base.set_servo(True)
+    wall = []
+    for i in range(n):
+        t0 = time.perf_counter()
+        assert base.move_cruise_abs((400.0 * (i + 1), 300.0 * (i % 2))).ok
+        wall.append(time.perf_counter() - t0)
+    world.close()
+    tenth = max(1, n // 10)
+    first, last = sorted(wall[:tenth]), sorted(wall[-tenth:])
+    print(f"  {n:4d} points added one by one: total {sum(wall):6.2f} s; per call p50 first tenth "
+          f"{1000 * first[len(first) // 2]:6.1f} ms, last tenth {1000 * last[len(last) // 2]:6.1f} ms, "
+          f"max {1000 * max(wall):6.1f} ms")
+
+
+def stop_while_planning(trials: int = 20) -> None:
+    """The core's control plane while another thread plans: a cruise runs (the simulation on its
+    own thread, real time), a thread adds a far cruise point (a long re-plan), and stop is called
+    as that plan starts. Wall time of stop and of get_state, and the largest gap between two
+    simulation steps meanwhile, against the control period."""
+    world = World()
+    executor = MotionExecutor(world, real_time_factor=1.0)
+    base = VehicleCore(executor)
+    steps: list[float] = []
+    executor.after_step(lambda _: steps.append(time.perf_counter()))
+    executor.start()
+    stops, states, gaps, plans = [], [], [], []
+    try:
+        base.set_power(True)
+        base.set_servo(True)
+        for _ in range(trials):
+            base.set_position((0.0, 0.0, 0.0))
+            base.move_cruise_abs((3000.0, 500.0))
+            while base.odometry.v < 0.2:
+                time.sleep(0.005)
+
+            def add() -> None:
+                t0 = time.perf_counter()
+                base.move_cruise_abs((90000.0, 90000.0))
+                plans.append(time.perf_counter() - t0)
+            planner = threading.Thread(target=add)
+            steps.clear()
+            planner.start()
+            time.sleep(0.005)
+            t0 = time.perf_counter()
+            base.get_state()
+            states.append(time.perf_counter() - t0)
+            t0 = time.perf_counter()
+            base.stop()
+            stops.append(time.perf_counter() - t0)
+            planner.join()
+            gaps.append(max(b - a for a, b in zip(steps, steps[1:])) if len(steps) > 1 else 0.0)
+            while base.device.busy:
+                time.sleep(0.01)
+    finally:
+        executor.shutdown()
+        world.close()
+
+    def pct(values: list[float], q: float) -> float:
+        return sorted(values)[min(len(values) - 1, int(q * len(values)))] * 1000.0
+    print(f"control plane while another thread plans (ROS-free core, {trials} trials; "
+          f"control period {1000 * executor.dt:.2f} ms):")
+    print(f"  concurrent plan (wall) p50 {pct(plans, 0.5):.1f} ms, max {pct(plans, 1.0):.1f} ms")
+    print(f"  stop      p50 {pct(stops, 0.5):.3f} ms, p99 {pct(stops, 0.99):.3f} ms, max {pct(stops, 1.0):.3f} ms")
+    print(f"  get_state p50 {pct(states, 0.5):.3f} ms, p99 {pct(states, 0.99):.3f} ms, max {pct(states, 1.0):.3f} ms")
+    print(f"  largest gap between simulation steps: p50 {pct(gaps, 0.5):.1f} ms, max {pct(gaps, 1.0):.1f} ms")
 
 
 if __name__ == "__main__":
     main()
+    print("planning cost of cruise points added one by one (a queued cruise; wall time):")
+    for count in (10, 50, 200):
+        adding_points(count)
+    stop_while_planning()

@@ -7,7 +7,7 @@ import pytest
 from acti_motion.vehicle.paths import TrackedBaseMotion
 from acti_motion.vehicle.core import VehicleState
 from sim_fixtures import executor, run_until  # noqa: F401
-from vehicle_fixtures import assert_at, base, position, ready, settle, state, steps  # noqa: F401
+from vehicle_fixtures import assert_at, base, position, ready, settle, state, steps, trace  # noqa: F401
 
 
 TRACKING_SETTLE = TrackedBaseMotion.SETTLE
@@ -105,35 +105,38 @@ def test_full_queue_refuses_and_keeps_what_is_queued(base):
     assert base.device.queue_length == 4
 
 
-def test_pause_keeps_the_queue_and_accepts_new_motions_resume_runs_them(base, executor):  # noqa: F811
+def test_pause_keeps_the_queue_and_accepts_new_motions_resume_runs_them(base, executor, trace):  # noqa: F811
     ready(base)
     base.move_forward(600.0)
-    steps(executor, 1.0)
+    trace.step(1.0)
     assert base.pause().ok and state(base) == VehicleState.BUSY        # decelerating
-    steps(executor, 1.0)
+    trace.step(1.0)
     assert state(base) == VehicleState.PAUSED
     held = position(base)
-    steps(executor, 1.0)
+    trace.step(1.0)
     assert position(base) == pytest.approx(held, abs=0.5)          # at rest
     assert abs(base.odometry.v) < 1e-3
     assert base.move_turn(90.0).ok                                  # Paused accepts "Ready only"
     assert base.move_linear_abs((600.0, 300.0, 90.0)).ok
     assert base.device.queue_length == 2 and state(base) == VehicleState.PAUSED
     assert base.resume().ok
-    settle(executor, base)
+    trace.until_idle()
+    trace.check()
     assert_at(base, 600.0, 300.0, 90.0)
     assert base.device.completed == 3
 
 
-def test_stop_decelerates_at_the_maximum_and_discards_everything(base, executor):  # noqa: F811
+def test_stop_decelerates_at_the_maximum_and_discards_everything(base, executor, trace):  # noqa: F811
     ready(base)
     base.set_velocity((600.0, 45.0))
     base.move_forward(3000.0)
     base.move_turn(90.0)
-    run_until(executor, lambda: base.odometry.v > 0.59, 5.0)
+    trace.until(lambda: base.odometry.v > 0.59, 5.0)
     assert base.stop().ok
+    rest = base.device.queued_end
     assert base.device.queue_length == 0
-    took = settle(executor, base)
+    took = trace.until_idle()
+    trace.check(rest=rest)
     assert took < 0.6 / 1.0 + TRACKING_SETTLE + 0.1
     assert state(base) == VehicleState.READY
     x, y, th = position(base)
@@ -141,12 +144,14 @@ def test_stop_decelerates_at_the_maximum_and_discards_everything(base, executor)
     assert base.move_forward(100.0).ok                              # and it moves on
 
 
-def test_servo_off_while_moving_stops_first(base, executor):  # noqa: F811
+def test_servo_off_while_moving_stops_first(base, executor, trace):  # noqa: F811
     ready(base)
     base.move_forward(1000.0)
-    steps(executor, 1.0)
+    trace.step(1.0)
     assert base.set_servo(False).ok and state(base) == VehicleState.POWERED
-    settle(executor, base, 2.0)
+    rest = base.device.queued_end
+    trace.until_idle(2.0)
+    trace.check(rest=rest)
     steps(executor, 0.5)
     assert abs(base.odometry.v) < 1e-3
 

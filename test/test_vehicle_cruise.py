@@ -5,7 +5,7 @@ import math
 import pytest
 
 from sim_fixtures import executor  # noqa: F401
-from vehicle_fixtures import assert_at, base, ready, steps  # noqa: F401
+from vehicle_fixtures import assert_at, base, ready, steps, trace  # noqa: F401
 
 POINTS = [(1000.0, 500.0), (2000.0, 0.0), (3000.0, 500.0), (3300.0, 1300.0)]
 
@@ -122,19 +122,24 @@ def test_continuous_rel_from_rest(base, executor):  # noqa: F811
     assert_at(base, 300.0, 400.0, 45.0)
 
 
+def setting(base):
+    (at, ar) = base.acceleration
+    return at / 1000.0, math.radians(ar)
+
+
 @pytest.mark.parametrize("rel, keeps_moving", [((1500.0, 400.0, 30.0), True),
                                                 ((-500.0, 0.0, 0.0), False)])
 def test_continuous_rel_new_target_replaces_the_old_with_continuous_velocity(
-        base, executor, rel, keeps_moving):  # noqa: F811
+        base, executor, trace, rel, keeps_moving):  # noqa: F811
     ready(base)
     first = base.move_continuous_rel((2000.0, 0.0, 0.0)).values["motion_id"]
-    speeds = run_recording_speed(executor, base, 1.5)
+    trace.step(1.5)
     here = reference_now(base)
     assert base.move_continuous_rel(rel).values["motion_id"] == first
-    speeds += run_recording_speed(executor, base)
+    trace.until_idle()
     assert_at(base, *expected_mm(here, rel))
-    assert max_accel(speeds, executor.dt) < 0.5 * 1.3           # no jump in speed
-    transition = speeds[int(1.5 / executor.dt):int(2.5 / executor.dt)]
+    trace.check(accel=setting(base))                              # no jump in speed
+    transition = [p.v for p in trace.points[int(1.5 / executor.dt):int(2.5 / executor.dt)]]
     assert (min(transition) > 0.2) == keeps_moving
     assert base.device.completed == 1
 
@@ -151,13 +156,34 @@ def test_continuous_rel_keeps_only_the_last_target(base, executor):  # noqa: F81
     assert_at(base, *expected_mm(here, rel))
 
 
-def test_continuous_rel_queued_behind_a_move_is_retargeted_from_its_start(base, executor):  # noqa: F811
+def test_continuous_rel_replaces_the_moves_not_started_yet(base, executor):  # noqa: F811
     ready(base)
     base.move_linear_abs((500.0, 0.0, 90.0))
-    a = base.move_continuous_rel((100.0, 0.0, 0.0)).values["motion_id"]
-    assert base.move_continuous_rel((300.0, 0.0, 0.0)).values["motion_id"] == a == 2
+    base.move_continuous_rel((100.0, 0.0, 0.0))
+    assert base.move_continuous_rel((300.0, 0.0, 0.0)).values["motion_id"] == 3
     run_recording_speed(executor, base)
-    assert_at(base, 500.0, 300.0, 90.0)
+    assert_at(base, 300.0, 0.0, 0.0)
+    assert (base.device.completed, base.device.discarded) == (1, 2)
+
+
+@pytest.mark.parametrize("running", ["move_linear_abs", "move_cruise_abs"])
+def test_continuous_rel_takes_over_another_kind_of_move_smoothly(base, executor, trace, running):  # noqa: F811
+    ready(base)
+    if running == "move_linear_abs":
+        base.move_linear_abs((3000.0, 0.0, 0.0))
+    else:
+        base.move_cruise_abs((3000.0, 0.0))
+    base.move_linear_abs((0.0, 0.0, 0.0))                       # queued behind: given up
+    trace.step(2.0)
+    here = reference_now(base)
+    r = base.move_continuous_rel((800.0, 300.0, 0.0))
+    assert r.ok and base.device.current.label == "move_continuous_rel"
+    assert base.device.queue_length == 0
+    trace.until_idle()
+    assert_at(base, *expected_mm(here, (800.0, 300.0, 0.0)))
+    trace.check(accel=setting(base))
+    assert min(p.v for p in trace.points[int(2.0 / executor.dt):int(2.5 / executor.dt)]) > 0.2
+    assert (base.device.completed, base.device.discarded) == (1, 1)
 
 
 def test_set_velocity_while_cruising(base, executor):  # noqa: F811

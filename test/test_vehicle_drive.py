@@ -48,13 +48,29 @@ def test_jog_refuses_bad_velocities(base, x_vel, y_vel, theta_vel, words):
     assert not r.ok and words in r.comment and base.device.last_id == 0
 
 
-def test_jog_needs_the_servo_and_an_idle_base(base):
+def test_jog_needs_only_the_servo_and_takes_over_a_move(base, executor):  # noqa: F811
     r = base.move_jog(100.0, 0.0, 0.0)
     assert not r.ok and "Unpowered" in r.comment
     ready(base)
-    assert base.move_forward(500.0).ok
-    r = base.move_jog(100.0, 0.0, 0.0)
-    assert not r.ok and "queued" in r.comment and base.device.last_id == 1
+    assert base.move_forward(500.0).ok and base.move_linear_abs((0.0, 500.0, 0.0)).ok
+    r = base.move_jog(100.0, 0.0, 0.0)                    # accepted, not yet started: replaced
+    assert r.ok and r.values["motion_id"] == 3 and base.device.queue_length == 1
+    steps(executor, 0.3)
+    assert base.device.current.label == "move_jog"
+    assert base.move_linear_abs((0.0, 500.0, 0.0)).ok     # queues behind the jog …
+    assert base.move_jog(200.0, 0.0, 0.0).values["motion_id"] == 3   # … which the next one drops
+    assert base.device.queue_length == 0 and base.device.discarded == 3
+
+
+def test_jog_takes_over_a_running_move_with_continuous_speed(base, executor):  # noqa: F811
+    ready(base)
+    base.set_jog_timeout(3000)
+    base.move_forward(2000.0)
+    speeds = []
+    run_until(executor, lambda: speeds.append(base.odometry.v) or base.odometry.v > 0.25, 5.0)
+    assert base.move_jog(-100.0, 0.0, 0.0).ok and base.device.current.label == "move_jog"
+    run_until(executor, lambda: speeds.append(base.odometry.v) or base.odometry.v < -0.09, 5.0)
+    assert max(abs(b - a) for a, b in zip(speeds, speeds[1:])) / executor.dt < 0.5 * 1.3
 
 
 def test_joystick_drives_within_the_settings_and_off_brakes_to_ready(base, executor):  # noqa: F811

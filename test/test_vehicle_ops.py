@@ -7,7 +7,7 @@ import pytest
 from acti_motion.vehicle.core import FIRMWARE_VERSION, IF_VERSION, VehicleConfig, VehicleCore, VehicleState
 from acti_motion.vehicle.alarms import AlarmCode, AlarmType
 from sim_fixtures import executor, run_until  # noqa: F401
-from vehicle_fixtures import base, ready, settle, state, state_msg, steps  # noqa: F401
+from vehicle_fixtures import base, ready, settle, state, state_msg, steps, trace  # noqa: F401
 
 NAN, INF = math.nan, math.inf
 
@@ -330,28 +330,31 @@ def test_always_true_operations(base):
     assert base.get_position().ok and base.get_battery_voltage().ok
 
 
-def test_set_power_off_while_moving_stops_and_drops_the_servo(base, executor):  # noqa: F811
+def test_set_power_off_while_moving_stops_and_drops_the_servo(base, executor, trace):  # noqa: F811
     ready(base)
     base.move_forward(1000.0)
-    steps(executor, 1.0)
+    trace.step(1.0)
     assert base.set_power(False).ok and state(base) == VehicleState.UNPOWERED and not base.servo
     assert base.device.queue_length == 0
-    settle(executor, base, 2.0)
+    rest = base.device.queued_end
+    trace.until_idle(2.0)
+    trace.check(rest=rest)
     steps(executor, 0.3)
     assert abs(base.odometry.v) < 1e-3
     assert base.set_power(True).ok and state(base) == VehicleState.POWERED
 
 
-def test_pause_reports_busy_until_the_base_is_at_rest(base, executor):  # noqa: F811
+def test_pause_reports_busy_until_the_base_is_at_rest(base, executor, trace):  # noqa: F811
     ready(base)
     base.set_velocity((800.0, 45.0))
     base.move_forward(2000.0)
-    run_until(executor, lambda: base.odometry.v > 0.79, 5.0)
+    trace.until(lambda: base.odometry.v > 0.79, 5.0)
     base.pause()
     assert state(base) == VehicleState.BUSY                  # decelerating at the maximum
-    took = run_until(executor, lambda: state(base) == VehicleState.PAUSED, 2.0)
+    took = trace.until(lambda: state(base) == VehicleState.PAUSED, 2.0)
     assert took == pytest.approx(0.8 / 1.0, abs=0.05)        # 800 mm/s at 1000 mm/s²
     assert abs(base.odometry.v) < 0.02
+    trace.check()
 
 
 @pytest.mark.parametrize("config", [dict(default_velocity_translation=2000.0),

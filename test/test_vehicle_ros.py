@@ -139,6 +139,29 @@ def test_topics_state_diagnostics_odom_and_cmd_vel(ros, vehicle):
     assert vehicle.alive()
 
 
+def test_cmd_vel_over_the_limit_is_clamped_and_said_once(ros, vehicle):
+    got = []
+    sub = ros.node.create_subscription(Odometry, "/odom", got.append, 10)
+    cmd = ros.node.create_publisher(Twist, "/cmd_vel", 10)
+    try:
+        assert call(ros, "set_power", on_off=True).success and call(ros, "set_servo", on_off=True).success
+        assert wait_until(lambda: state(ros) == 0x010, 10.0)
+        twist = Twist()
+        twist.linear.x, twist.linear.y, twist.angular.z = 5.0, 0.3, -10.0     # m/s, rad/s
+        deadline = time.monotonic() + 1.0
+        while time.monotonic() < deadline:
+            cmd.publish(twist)
+            ros.executor.spin_once(timeout_sec=0.05)
+        assert ros.spin_until(lambda: got and got[-1].twist.twist.linear.x > 0.3, 5.0)
+        assert max(m.twist.twist.linear.x for m in got) < 1.0 * 1.1            # the unit's limit
+        assert wait_until(lambda: state(ros) == 0x010, 10.0)                    # stops by itself
+        assert vehicle.log().count("cmd_vel is clamped") == 1
+    finally:
+        ros.node.destroy_subscription(sub)
+        ros.node.destroy_publisher(cmd)
+    assert vehicle.alive()
+
+
 def test_joystick_over_the_joy_topic(ros, vehicle):
     from sensor_msgs.msg import Joy
     got = []

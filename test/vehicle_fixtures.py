@@ -45,3 +45,10 @@ def assert_at(base, x: float, y: float, theta: float, mm: float = 5.0, deg: floa
 def steps(executor, seconds: float) -> None:  # noqa: F811
     for _ in range(round(seconds / executor.dt)):
         executor.step()
+
+
+@pytest.fixture
+def trace(base, executor):  # noqa: F811
+    """A BaseTrace of the base (trajectory_check_base): step through it, then check it."""
+    from trajectory_check_base import BaseTrace
+    return BaseTrace(executor, base)

@@ -7,7 +7,8 @@ Topics (REP 103: m, rad):
   ~/ground_truth (nav_msgs/Odometry)  the simulator's true pose of base_link in the world, 50 Hz
   ~/state (acti_msgs/VehicleStatus)   state code and string of table 7 and what makes it, 10 Hz
   /diagnostics (DiagnosticArray)      battery and alarms, 1 Hz
-  cmd_vel (geometry_msgs/Twist, in)   a move_jog per message (stops after the jog timeout)
+  cmd_vel (geometry_msgs/Twist, in)   a move_jog per message (stops after the jog timeout),
+                                      clamped to the unit's limits (said once in the log)
   joy (sensor_msgs/Joy, in)           drives the base while set_joystick(true)
 """
 from __future__ import annotations
@@ -105,6 +106,7 @@ class VehicleNode(Node):
         self._truth = self.create_publisher(Odometry, "~/ground_truth", 10)
         self._state = self.create_publisher(VehicleStatus, "~/state", 10)
         self._diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
+        self._cmd_vel_clamped = False
         self.create_subscription(Twist, "cmd_vel", self._on_cmd_vel, 10)
         self.create_subscription(Joy, "joy", self._on_joy, 10)
         rate = self.simulation.config.rate_hz
@@ -115,8 +117,15 @@ class VehicleNode(Node):
 
     # --- topics in ---------------------------------------------------------------------------
     def _on_cmd_vel(self, msg: Twist) -> None:
-        reply = self.core.move_jog(x_vel=1000.0 * msg.linear.x, y_vel=1000.0 * msg.linear.y,
-                                   theta_vel=math.degrees(msg.angular.z))
+        """Clamp to the unit's limits, as ROS base drivers do (a differential drive ignores
+        linear.y); say so once."""
+        x, th, clamped = self.core.clamp_velocity(1000.0 * msg.linear.x, math.degrees(msg.angular.z))
+        if (clamped or msg.linear.y != 0.0) and not self._cmd_vel_clamped:
+            self._cmd_vel_clamped = True
+            self.get_logger().info(
+                f"cmd_vel is clamped to the unit's limits ({x:g} mm/s, {th:g} degree/s) and "
+                "linear.y is ignored (differential drive); this is logged once")
+        reply = self.core.move_jog(x_vel=x, y_vel=0.0, theta_vel=th)
         if not reply.ok:
             self.get_logger().warn(f"cmd_vel refused: {reply.comment}", throttle_duration_sec=2.0)
 

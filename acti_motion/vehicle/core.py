@@ -8,156 +8,54 @@ mm/s, degree/s, mm/s², degree/s², ms; the motion layer below works in m, rad, 
 """
 from __future__ import annotations
 
-import functools
 import math
 import threading
-from dataclasses import dataclass
-from enum import IntEnum
+import time
 from typing import Any, Callable
 
-from acti_motion.vehicle.paths import (BrakeMotion, Odometry, Path, Pose2D, TrackedBaseMotion, arc, line,
-                              straight_to, turn, velocity_path)
-from acti_motion.vehicle.cruise import CruiseMotion, transition_to
-from acti_motion.executor import Device, MotionExecutor
-from acti_motion.replies import Refused, ReturnCode, answers, finite_number
+from acti_motion.executor import STALE, Device, MotionExecutor
+from acti_motion.replies import Refused, Reply, finite_number
 from acti_motion.vehicle.alarms import AlarmCode, Alarms, AlarmType, Kind
-from acti_sim.battery import Battery, BatteryModel
+from acti_motion.vehicle.config import VehicleConfig
+from acti_motion.vehicle.cruise import CruiseMotion, plan_curve, transition_to
+from acti_motion.vehicle.paths import (BrakeMotion, Odometry, Path, Pose2D, TrackedBaseMotion, arc,
+                                       line, straight_to, turn, velocity_path)
+from acti_motion.vehicle.refusals import (Discarded, VehicleRefused, bounded_pair, command, finite_pose,
+                                          invalid, planned, query)
+from acti_motion.vehicle.sensing import VELOCITY_DRIVEN, Sensing
+from acti_motion.vehicle.states import IDLE, SERVO_ON, STATE_STRINGS, VehicleState
+from acti_sim.battery import Battery, BatteryModel, VoltageLevel
 from acti_sim.io_module import IoModule
-from acti_sim.world import World
 
 IF_VERSION = "RTC VehicleService interface: ver.2.0.0"
 FIRMWARE_VERSION = "Ver.1.0.0.1"
 WHEEL_AXES = (0, 1)                      # getServoStatus ids: left, right wheel motor
-VELOCITY_DRIVEN = ("move_jog", "joystick")  # motions driven by a velocity, not a target
 
 
-class VehicleState(IntEnum):
-    """Table 7 of the VehicleService spec: state code → the state string's stem."""
-    READY = 0x010
-    BUSY = 0x011
-    WARNING = 0x012
-    ALARM = 0x013
-    STUCK = 0x014
-    PAUSED = 0x015
-    AVOID = 0x016
-    LOCKED = 0x017
-    POWERED = 0x018
-    UNPOWERED = 0x019
+LOOKAHEAD_STEPS = 2          # control periods ahead of now that an edit planned off-lock splices in …
+LOOKAHEAD_GROWTH = 4         # … times this for each attempt the device outran
 
 
-STATE_STRINGS = {
-    VehicleState.READY: "Ready", VehicleState.BUSY: "Busy", VehicleState.WARNING: "Warning",
-    VehicleState.ALARM: "Alarm", VehicleState.STUCK: "Stuck", VehicleState.PAUSED: "Paused",
-    VehicleState.AVOID: "Avoid", VehicleState.LOCKED: "Locked", VehicleState.POWERED: "Powered",
-    VehicleState.UNPOWERED: "Unpowered",
-}
-# "Ready only" moves (moveForward, moveTurn, moveLinearRel, moveCircularRel) run from an idle base;
-# Paused is idle too, and the pause operation says commands given then are kept for resume.
-IDLE = (VehicleState.READY, VehicleState.WARNING, VehicleState.STUCK, VehicleState.PAUSED)
-# "Servo on only" moves (moveLinearAbs, moveContinuousRel, moveCruiseAbs, moveJog) also queue
-# behind a moving base; Alarm and Locked refuse every motion until clearAlarm / unlock.
-SERVO_ON = IDLE + (VehicleState.BUSY, VehicleState.AVOID)
+class VehicleCore(Sensing):
+    """Power, servo, state, alarms, I/O, battery, odometry and the motion queue of the base.
 
-
-@dataclass
-class VehicleConfig:
-    """Start-up settings and limits of the base (spec units); the node's parameters."""
-    queue_size: int = 32                         # motion queue capacity
-    velocity_limit_translation: float = 1000.0   # velocity limit, translation [mm/s]
-    velocity_limit_rotation: float = 90.0        # velocity limit, rotation [degree/s]
-    accel_limit_translation: float = 1000.0      # acceleration limit, translation [mm/s²]
-    accel_limit_rotation: float = 180.0          # acceleration limit, rotation [degree/s²]
-    default_velocity_translation: float = 300.0  # velocity at start-up [mm/s]
-    default_velocity_rotation: float = 45.0      # turn rate at start-up [degree/s]
-    default_accel_translation: float = 500.0     # acceleration at start-up [mm/s²]
-    default_accel_rotation: float = 90.0         # turn acceleration at start-up [degree/s²]
-    jog_timeout: int = 500                       # ms from the last jog command to the stop
-    joy_axis_linear: int = 1                     # sensor_msgs/Joy axis for forward speed …
-    joy_axis_angular: int = 0                    # … and for the yaw rate (left stick)
-    joy_enable_button: int = -1                  # a button that must be held (-1: none)
-    io_config: str = ""                          # I/O ids (YAML); "" = config/vehicle_io.yaml
-    battery_capacity_wh: float = 960.0           # battery capacity [Wh]
-    battery_charge: float = 1.0                  # state of charge at start-up, 0 … 1
-    battery_low_voltage: float = 46.0            # V: warning 110 below
-    battery_cutoff_voltage: float = 44.0         # V: fault 201 below (servo off)
-    stuck_error: float = 100.0                   # mm of tracking error …
-    stuck_angle: float = 20.0                    # … or degrees of heading error …
-    stuck_time: float = 0.3                      # … held this long (s): the base is Stuck
-
-
-POWER_IDLE_W = 30.0          # electronics while the main power is on
-POWER_SERVO_W = 20.0         # wheel servos holding
-DRIVE_LOSS_N = 150.0         # rolling and drive-train resistance of the moving base
-DRIVE_EFFICIENCY = 0.8
-
-
-class VehicleRefused(Refused):
-    """A refusal with the warning code it raises."""
-
-    def __init__(self, alarm: AlarmCode, comment: str) -> None:
-        super().__init__(ReturnCode.NG, comment)
-        self.alarm = alarm
-
-
-WARNING_FOR = {ReturnCode.VALUE_ERR: AlarmCode.INVALID_VALUE,
-               ReturnCode.STATUS_ERR: AlarmCode.WRONG_STATE,
-               ReturnCode.FULL_MOTION_QUEUE_ERR: AlarmCode.QUEUE_FULL}
-
-
-def invalid(message: str) -> VehicleRefused:
-    return VehicleRefused(AlarmCode.INVALID_VALUE, message)
-
-
-def _operation(clears_warnings: bool) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
-    def decorate(fn: Callable[..., Any]) -> Callable[..., Any]:
-        @functools.wraps(fn)
-        def recorded(self: "VehicleCore", *args: Any, **kwargs: Any) -> Any:
-            with self.lock:
-                try:
-                    out = fn(self, *args, **kwargs)
-                except Refused as r:
-                    code = getattr(r, "alarm", None) or WARNING_FOR.get(r.code, AlarmCode.INVALID_VALUE)
-                    self.alarms.raise_(code, f"{fn.__name__}: {r.comment}", Kind.COMMAND)
-                    raise
-                if clears_warnings:
-                    self.alarms.clear(Kind.COMMAND)
-                return out
-        return answers(recorded)
-    return decorate
-
-
-command = _operation(clears_warnings=True)    # changes something: success clears command warnings
-query = _operation(clears_warnings=False)     # reads: a refusal (unknown id) still warns
-
-
-def positive_pair(values: Any, limits: tuple[float, float], name: str, unit: tuple[str, str]) -> tuple[float, float]:
-    """(translation, rotation), each finite, > 0 and within its limit."""
-    out = []
-    for value, limit, part, u in zip(values, limits, ("translation", "rotation"), unit):
-        v = finite_number(value, f"{name}.{part}")
-        if not 0.0 < v <= limit:
-            raise invalid(f"{name}.{part} is {v:g} {u}: it must be > 0 and at most {limit:g} {u}")
-        out.append(v)
-    return out[0], out[1]
-
-
-def finite_pose(pos: Any, name: str = "pos") -> Pose2D:
-    """A Position (mm, mm, degree) as a Pose2D (m, m, rad)."""
-    x, y, theta = (finite_number(v, f"{name}.{f}") for v, f in zip(pos, ("x", "y", "theta")))
-    return Pose2D(x / 1000.0, y / 1000.0, math.radians(theta))
-
-
-class VehicleCore:
-    """Power, servo, state, alarms, I/O, battery, odometry and the motion queue of the base."""
+    Two locks: `lock` guards the state for a moment (control operations, checks, commits);
+    `planning` lets one planning operation at a time plan, under no lock that the control
+    operations or the simulation take. A plan is committed only if the device did not change
+    meanwhile (the device's generation and revision), else it is planned again.
+    """
 
     def __init__(self, executor: MotionExecutor, config: VehicleConfig | None = None) -> None:
         self.config = c = config or VehicleConfig()
         world = executor.world
         self.lock = threading.RLock()
+        self.planning = threading.RLock()
         self.odometry = Odometry(world.wheel_radius, world.wheel_separation, world.wheel_positions())
         self.device: Device = executor.add_device("base", c.queue_size, self.odometry.pose)
         self.alarms = Alarms()
         self.battery = Battery(BatteryModel(capacity_wh=c.battery_capacity_wh), c.battery_charge)
+        self._battery_low = VoltageLevel(c.battery_low_voltage, c.battery_hysteresis)
+        self._battery_empty = VoltageLevel(c.battery_cutoff_voltage, c.battery_hysteresis)
         self._contact = False
         self.io = IoModule.load(c.io_config, {"bumper": lambda: int(self._contact)})
         self.power = False
@@ -167,23 +65,35 @@ class VehicleCore:
         self.digital_sensor_lock = False
         self._contact_armed = True
         self._stuck_since: float | None = None
+        self._drive_deadline = math.inf      # time.monotonic() at which a jog/joystick drive ends
+        self._deadman_fired: int | None = None
+        self._op_generation = 0              # the device's generation when the planning operation began
+        self.velocity_bounds = ((c.velocity_min_translation, c.velocity_min_rotation),
+                                (c.velocity_limit_translation, c.velocity_limit_rotation))
+        self.accel_bounds = ((c.accel_min_translation, c.accel_min_rotation),
+                             (c.accel_limit_translation, c.accel_limit_rotation))
         try:                          # the start-up settings obey the rules of the setters
-            self.velocity = positive_pair(
-                (c.default_velocity_translation, c.default_velocity_rotation),
-                (c.velocity_limit_translation, c.velocity_limit_rotation), "default velocity",
-                ("mm/s", "degree/s"))
-            self.acceleration = positive_pair(
-                (c.default_accel_translation, c.default_accel_rotation),
-                (c.accel_limit_translation, c.accel_limit_rotation), "default acceleration",
-                ("mm/s²", "degree/s²"))
+            self.velocity = bounded_pair(
+                (c.default_velocity_translation, c.default_velocity_rotation), *self.velocity_bounds,
+                "default velocity", ("mm/s", "degree/s"))
+            self.acceleration = bounded_pair(
+                (c.default_accel_translation, c.default_accel_rotation), *self.accel_bounds,
+                "default acceleration", ("mm/s²", "degree/s²"))
         except Refused as r:
             raise ValueError(f"vehicle configuration: {r.comment}") from None
         if c.jog_timeout <= 0:
             raise ValueError(f"vehicle configuration: jog_timeout is {c.jog_timeout} ms, it must be > 0")
+        if not (c.work_area > 0 and c.turn_limit > 0):
+            raise ValueError("vehicle configuration: work_area and turn_limit must be > 0")
         self.jog_timeout = c.jog_timeout
         self.joystick = False
         self._dt = executor.dt
+        self._warm_up()
         executor.before_step(self._sense)
+
+    def _warm_up(self) -> None:
+        """Plan one short cruise now, so the first request does not pay for first-use costs."""
+        plan_curve(Pose2D(0.0, 0.0, 0.0), [(0.5, 0.2), (1.0, 0.0)], self._limits())
 
     # --- state ------------------------------------------------------------------------------
     def state(self) -> VehicleState:
@@ -195,10 +105,10 @@ class VehicleCore:
             return VehicleState.LOCKED
         if not self.servo:
             return VehicleState.POWERED
-        if self.stuck:
-            return VehicleState.STUCK
         if self.device.paused:        # Paused once at rest; Busy while it decelerates
             return VehicleState.BUSY if self.device.moving and self.device.rate > 0.0 else VehicleState.PAUSED
+        if self.stuck:
+            return VehicleState.STUCK
         if self.device.busy:
             return VehicleState.BUSY
         if self._latest_warning() is not None:
@@ -224,14 +134,16 @@ class VehicleCore:
 
     @command
     def set_power(self, on_off: bool) -> None:
-        """Main power; switching it off stops the base and drops the servo."""
-        if on_off and self.battery.voltage < self.config.battery_cutoff_voltage:
+        """Main power; switching it off stops the base and drops the servo. On is refused while
+        the battery is below its cut-off (with the hysteresis band)."""
+        if on_off and self._battery_empty.update(self.battery.voltage):
             raise VehicleRefused(AlarmCode.WRONG_STATE,
-                                 f"the battery is at {self.battery.voltage:.1f} V, below the "
-                                 f"cut-off {self.config.battery_cutoff_voltage:g} V: power stays off")
+                                 f"the battery is at {self.battery.voltage:.1f} V, below the cut-off "
+                                 f"{self.config.battery_cutoff_voltage:g} V + "
+                                 f"{self.config.battery_hysteresis:g} V: power stays off")
         if not on_off:
+            self.servo = False       # before the stop: a plan that commits after it sees it
             self._stop()
-            self.servo = False
         self.power = bool(on_off)
 
     @command
@@ -247,6 +159,7 @@ class VehicleCore:
                                  f"alarm {alarm.code} is active ({alarm.source}): the servo stays "
                                  "off until clear_alarm / unlock")
         if not on_off:
+            self.servo = False       # before the stop: a plan that commits after it sees it
             self._stop()
         self.servo = bool(on_off)
 
@@ -260,14 +173,12 @@ class VehicleCore:
     # --- alarms -----------------------------------------------------------------------------
     @command
     def clear_alarm(self) -> None:
-        """Clear every alarm whose cause is gone; a contact lock needs unlock."""
-        self.alarms.clear(Kind.COMMAND, Kind.STUCK)
+        """Clear every alarm (1.4.1: 発生した全てのアラームを解除). One whose cause is still there
+        is raised again at once: a battery still within its hysteresis band of the level. Stuck
+        ends; Locked is a state that only unlock leaves."""
+        self.alarms.clear(*Kind)
         self.stuck = False
-        v = self.battery.voltage
-        if v >= self.config.battery_cutoff_voltage:
-            self.alarms.clear(code=AlarmCode.BATTERY_EMPTY)
-        if v >= self.config.battery_low_voltage:
-            self.alarms.clear(code=AlarmCode.BATTERY_LOW)
+        self._check_battery(self.battery.voltage)
 
     @query
     def get_active_alarm(self, num_of_alarm: int) -> dict:
@@ -316,27 +227,24 @@ class VehicleCore:
         c = self.config
         return {"default_accel": (c.default_accel_translation, c.default_accel_rotation)}
 
-    @command
+    @planned
     def set_velocity(self, vel: Any) -> None:
-        """Within the unit's limits, > 0. A moving base changes speed smoothly (at the
+        """Within [velocity_min, limit]. A moving base changes speed smoothly (at the
         acceleration setting) to match; queued moves take it too. Jogs keep their velocities."""
-        c = self.config
-        self.velocity = positive_pair(vel, (c.velocity_limit_translation, c.velocity_limit_rotation),
-                                      "vel", ("mm/s", "degree/s"))
-        self._retime()
+        value = bounded_pair(vel, *self.velocity_bounds, "vel", ("mm/s", "degree/s"))
+        self._retime(value, self.acceleration)
+        self.velocity = value
 
-    @command
+    @planned
     def set_acceleration(self, accel: Any) -> None:
-        """Within the unit's limits, > 0; refused while moving (Busy, Avoid)."""
-        c = self.config
-        value = positive_pair(accel, (c.accel_limit_translation, c.accel_limit_rotation),
-                              "accel", ("mm/s²", "degree/s²"))
+        """Within [accel_min, limit]; refused while moving (Busy, Avoid)."""
+        value = bounded_pair(accel, *self.accel_bounds, "accel", ("mm/s²", "degree/s²"))
         s = self.state()
         if s in (VehicleState.BUSY, VehicleState.AVOID):
             raise VehicleRefused(AlarmCode.WRONG_STATE,
                                  f"the base is {STATE_STRINGS[s]}: set_acceleration is refused while moving")
+        self._retime(self.velocity, value)
         self.acceleration = value
-        self._retime()
 
     @command
     def set_jog_timeout(self, timeout: int) -> None:
@@ -350,10 +258,13 @@ class VehicleCore:
         p = self.odometry.pose
         return {"pos": (1000.0 * p.x, 1000.0 * p.y, math.degrees(p.theta))}
 
-    @command
+    @planned
     def set_position(self, pos: Any) -> None:
-        """Redefine the odometry pose; accepted motions keep their path on the floor."""
+        """Redefine the odometry pose (within the work area); accepted motions keep their path
+        on the floor. A planning operation: no plan can start from the old frame meanwhile."""
         new = finite_pose(pos)
+        self._check_rotation(new.theta, "pos.theta")
+        self._check_goal(new, "pos")
 
         def move_frame(device: Device) -> None:
             frame = self.odometry.reset(new)
@@ -386,9 +297,15 @@ class VehicleCore:
 
     # --- pause, resume, stop ----------------------------------------------------------------
     @command
-    def pause(self) -> None:
-        """Decelerate at the maximum acceleration and hold; the queue stays, new motions queue."""
+    def pause(self) -> Reply | None:
+        """Decelerate at the maximum acceleration and hold; the queue stays, new motions queue.
+        Ignored (still true, with a comment) where no motion can run: Unpowered, Powered,
+        Alarm, Locked; switching the servo off ends a pause."""
+        s = self.state()
+        if s not in SERVO_ON:
+            return Reply(comment=f"ignored: the base is {STATE_STRINGS[s]}, there is nothing to pause")
         self.device.pause(self._stop_ramp())
+        return None
 
     @command
     def resume(self) -> None:
@@ -396,40 +313,53 @@ class VehicleCore:
 
     @command
     def stop(self) -> None:
-        """Decelerate at the maximum acceleration and discard every motion."""
+        """Decelerate at the maximum acceleration and discard every motion, also those given
+        until the base is at rest."""
         self._stop()
 
     # --- motion -----------------------------------------------------------------------------
-    @command
+    @planned
     def move_forward(self, x: float) -> dict:
         distance = finite_number(x, "x") / 1000.0
         self._require(IDLE, "move_forward")
         limits = self._limits()
-        return self._submit(lambda start: line(start, distance, limits), "move_forward")
 
-    @command
+        def plan(start: Pose2D) -> Path:
+            self._check_goal(start.forward(distance), "the target")
+            return line(start, distance, limits)
+        return self._submit(plan, "move_forward", IDLE)
+
+    @planned
     def move_turn(self, theta: float) -> dict:
         angle = math.radians(finite_number(theta, "theta"))
+        self._check_rotation(angle, "theta")
         self._require(IDLE, "move_turn")
         limits = self._limits()
-        return self._submit(lambda start: turn(start, angle, limits), "move_turn")
+        return self._submit(lambda start: turn(start, angle, limits), "move_turn", IDLE)
 
-    @command
+    @planned
     def move_linear_rel(self, pos: Any) -> dict:
         rel = finite_pose(pos)
+        self._check_rotation(rel.theta, "pos.theta")
         self._require(IDLE, "move_linear_rel")
         limits = self._limits()
-        return self._submit(lambda start: straight_to(start, start.compose(rel), limits, False),
-                            "move_linear_rel")
 
-    @command
+        def plan(start: Pose2D) -> Path:
+            goal = self._check_goal(start.compose(rel), "the target")
+            return straight_to(start, goal, limits, False)
+        return self._submit(plan, "move_linear_rel", IDLE)
+
+    @planned
     def move_linear_abs(self, pos: Any) -> dict:
         goal = finite_pose(pos)
+        self._check_rotation(goal.theta, "pos.theta")
+        self._check_goal(goal, "pos")
         self._require(SERVO_ON, "move_linear_abs")
         limits = self._limits()
-        return self._submit(lambda start: straight_to(start, goal, limits, True), "move_linear_abs")
+        return self._submit(lambda start: straight_to(start, goal, limits, True), "move_linear_abs",
+                            SERVO_ON)
 
-    @command
+    @planned
     def move_circular_rel(self, center_point: Any, theta: float) -> dict:
         cx, cy = (finite_number(v, f"center_point.{f}") for v, f in zip(center_point, "xy"))
         angle = math.radians(finite_number(theta, "theta"))
@@ -437,69 +367,102 @@ class VehicleCore:
             raise VehicleRefused(AlarmCode.NOT_HOLONOMIC,
                                  f"center_point.x is {cx:g} mm: a differential drive turns only "
                                  "about a point on its wheel axle (x = 0)")
+        self._check_rotation(angle, "theta")
+        if abs(cy) > self.config.work_area:
+            raise invalid(f"center_point.y is {cy:g} mm: the centre must lie within the work area "
+                          f"(±{self.config.work_area:g} mm)")
         self._require(IDLE, "move_circular_rel")
         limits = self._limits()
-        return self._submit(lambda start: arc(start, cy / 1000.0, angle, limits), "move_circular_rel")
 
-    @command
+        def plan(start: Pose2D) -> Path:
+            path = arc(start, cy / 1000.0, angle, limits)
+            self._check_goal(path.pose(path.duration), "the target")
+            return path
+        return self._submit(plan, "move_circular_rel", IDLE)
+
+    @planned
     def move_cruise_abs(self, cruise_point: Any) -> dict:
         """Pass cruise_point (odometry frame) smoothly: points given while the base cruises are
         appended to its path, so it stops only at the last; TOPP-RA times the path within the
-        velocity and acceleration settings."""
+        velocity and acceleration settings. Each point costs the same to add, however many
+        came before (only the path after the last point but one is planned again)."""
         px, py = (finite_number(v, f"cruise_point.{f}") for v, f in zip(cruise_point, "xy"))
+        point = (px / 1000.0, py / 1000.0)
+        self._check_goal(Pose2D(*point, 0.0), "cruise_point")
         self._require(SERVO_ON, "move_cruise_abs")
-        point, limits, odometry = (px / 1000.0, py / 1000.0), self._limits(), self.odometry
+        limits, odometry = self._limits(), self.odometry
 
-        def extend(device: Device) -> int | None:
+        def look(device: Device, attempt: int):
             last = device.queue[-1] if device.queue else device.current
-            if last is None or last.label != "move_cruise_abs":
+            if last is None or last.label != "move_cruise_abs" or not isinstance(last.motion, CruiseMotion):
                 return None
             running = last is device.current
             if running and device.stopping:
                 return None
-            last.motion.limits = limits
-            return last.id if last.motion.add_point(point, device.t if running else 0.0) else None
-        motion_id = self.device.edit(extend)
+            return last, running, self._splice_time(device, last.motion, attempt) if running else 0.0
+
+        def plan(seen):
+            if seen is None:
+                return lambda device: None
+            last, running, t = seen
+            update = last.motion.plan(t, [point], limits)
+
+            def commit(device: Device) -> int | None:
+                if update is None:
+                    return None
+                if running and device.t > t:
+                    return STALE
+                self._admit(SERVO_ON, "move_cruise_abs", device)
+                last.motion.commit(update)
+                return last.id
+            return commit
+        motion_id = self._edit(look, plan)
         if motion_id is not None:
             self._accepted_motion()
             return {"motion_id": motion_id}
         return self._submit_motion(lambda start: CruiseMotion(odometry, start, point, limits),
-                                   "move_cruise_abs")
+                                   "move_cruise_abs", SERVO_ON)
 
-    @command
+    @planned
     def move_continuous_rel(self, pos: Any) -> dict:
-        """Go to pos relative to the base. Given again while the base is on its way, the new
-        target (relative to where the base is then) replaces the old one and the base turns onto
-        it with continuous velocity; behind other queued moves it waits its turn."""
+        """Go to pos relative to the base. Given while the base moves (any move but a brake),
+        the new target (relative to where the base is then) takes over: the base turns onto it
+        with continuous velocity and every move queued behind is discarded (1.4.15: 連続実行
+        した場合，最後に設定された目標点以外は消去; 移動中に実行すると…新たな経路へと移行)."""
         rel = finite_pose(pos)
+        self._check_rotation(rel.theta, "pos.theta")
         self._require(SERVO_ON, "move_continuous_rel")
         limits, label = self._limits(), "move_continuous_rel"
 
-        def retarget(device: Device) -> int | None:
-            last = device.queue[-1] if device.queue else device.current
-            if last is None or last.label != label:
+        def look(device: Device, attempt: int):
+            cur = self._running(device)
+            if cur is None:
                 return None
-            if last is not device.current:                       # queued: plan it again
-                start = last.motion.at(0.0)
-                last.motion.splice(0.0, straight_to(start, start.compose(rel), limits, False))
-                return last.id
-            if device.stopping:
-                return None
-            t, motion = device.t, last.motion
-            here = motion.at(t)
-            motion.splice(t, transition_to(here, *motion.reference_twist(t), here.compose(rel), limits))
-            return last.id
-        motion_id = self.device.edit(retarget)
+            return cur, cur.motion.at(device.t), self._splice_time(device, cur.motion, attempt)
+
+        def plan(seen):
+            if seen is None:
+                return self._discard_not_started
+            cur, here, t = seen
+            goal = self._check_goal(here.compose(rel), "the target")
+            motion = cur.motion
+            path = transition_to(motion.at(t), *motion.reference_twist(t), goal, limits)
+            return lambda device: self._take_over(device, cur, t, path, label)
+        motion_id = self._edit(look, plan)
         if motion_id is not None:
             self._accepted_motion()
             return {"motion_id": motion_id}
-        return self._submit(lambda start: straight_to(start, start.compose(rel), limits, False), label)
 
-    @command
+        def from_rest(start: Pose2D) -> Path:
+            return straight_to(start, self._check_goal(start.compose(rel), "the target"), limits, False)
+        return self._submit(from_rest, label, SERVO_ON)
+
+    @planned
     def move_jog(self, x_vel: float, y_vel: float, theta_vel: float) -> dict:
-        """Drive at (x_vel, theta_vel) until jog_timeout ms after the last call, then decelerate.
-        Each velocity is signed (backwards, clockwise) and at most the unit's limit; y_vel must
-        be 0 on a differential drive. A jog starts on an idle base or updates the running jog."""
+        """Drive at (x_vel, theta_vel) until jog_timeout ms (wall time) after the last call, then
+        decelerate. Each velocity is signed (backwards, clockwise) and at most the unit's limit;
+        y_vel must be 0 on a differential drive. Servo on: a jog starts on an idle base, updates
+        the running jog, or takes over a running move (discarding the moves queued behind)."""
         c = self.config
         vx, vy, vth = (finite_number(v, n) for v, n in zip((x_vel, y_vel, theta_vel),
                                                             ("x_vel", "y_vel", "theta_vel")))
@@ -513,9 +476,17 @@ class VehicleCore:
         self._require(SERVO_ON, "move_jog")
         (at, ar) = self.acceleration
         return self._drive((vx / 1000.0, math.radians(vth)), self.jog_timeout / 1000.0,
-                           (at / 1000.0, math.radians(ar)), "move_jog")
+                           (at / 1000.0, math.radians(ar)), "move_jog", take_over=True)
 
-    @command
+    def clamp_velocity(self, x_vel: float, theta_vel: float) -> tuple[float, float, bool]:
+        """(x_vel mm/s, theta_vel degree/s) clamped to the unit's limits, and whether they were:
+        cmd_vel is clamped, as ROS base drivers do, where move_jog refuses."""
+        c = self.config
+        x = min(c.velocity_limit_translation, max(-c.velocity_limit_translation, x_vel))
+        th = min(c.velocity_limit_rotation, max(-c.velocity_limit_rotation, theta_vel))
+        return x, th, (x, th) != (x_vel, theta_vel) and math.isfinite(x_vel) and math.isfinite(theta_vel)
+
+    @planned
     def set_joystick(self, on_off: bool) -> None:
         """Joystick on: its input drives the base (within the velocity and acceleration settings).
         Off while it drives: decelerate at the maximum acceleration, then Ready."""
@@ -524,13 +495,16 @@ class VehicleCore:
         if not on_off and cur is not None and cur.label == "joystick":
             c = self.config
             self._drive((0.0, 0.0), 0.0, (c.accel_limit_translation / 1000.0,
-                                          math.radians(c.accel_limit_rotation)), "joystick")
+                                          math.radians(c.accel_limit_rotation)), "joystick",
+                        take_over=False)
 
     def joy_input(self, axes: list[float], buttons: list[int]) -> bool:
         """A sensor_msgs/Joy sample (not an IDL operation): full stick = the velocity setting.
-        Ignored (False) with the joystick off, the servo off, an alarm, or moves in the queue."""
+        Ignored (False) with the joystick off, the servo off, an alarm, or other moves running
+        or queued."""
         c = self.config
-        with self.lock:
+        with self.planning:
+            self._op_generation = self.device.generation
             if not self.joystick or self.state() not in SERVO_ON:
                 return False
             if c.joy_enable_button >= 0 and not (c.joy_enable_button < len(buttons)
@@ -544,14 +518,27 @@ class VehicleCore:
             target = (axis(c.joy_axis_linear) * vt / 1000.0, math.radians(axis(c.joy_axis_angular) * vr))
             try:
                 self._drive(target, self.jog_timeout / 1000.0, (at / 1000.0, math.radians(ar)),
-                            "joystick")
+                            "joystick", take_over=False)
             except Refused:
                 return False
             return True
 
     # --- helpers ----------------------------------------------------------------------------
     def _require(self, allowed: tuple[VehicleState, ...], operation: str) -> None:
+        with self.lock:
+            self._refuse_unless(self.state(), allowed, operation)
+
+    def _admit(self, allowed: tuple[VehicleState, ...], operation: str, device: Device) -> None:
+        """The check a planned motion passes when it is committed (after planning): still in
+        an allowed state; and if a stop decelerates, or came in since the operation began, it
+        is discarded (stop discards every motion command). Takes no lock, so that it can run
+        inside the device's."""
         s = self.state()
+        if (device.stopping or device.generation != self._op_generation) and s in SERVO_ON:
+            raise Discarded(operation)
+        self._refuse_unless(s, allowed, operation)
+
+    def _refuse_unless(self, s: VehicleState, allowed: tuple[VehicleState, ...], operation: str) -> None:
         if s not in allowed:
             need = "Ready" if allowed == IDLE else "the servo on"
             raise VehicleRefused(AlarmCode.WRONG_STATE,
@@ -566,19 +553,83 @@ class VehicleCore:
                 VehicleState.LOCKED: " (call unlock)",
                 VehicleState.BUSY: " (wait, or call stop)"}.get(s, "")
 
-    def _limits(self) -> tuple[float, float, float, float]:
+    def _check_goal(self, goal: Pose2D, what: str) -> Pose2D:
+        """Refuse a target outside the work area (a plan there could not be made quickly)."""
+        area = self.config.work_area
+        if not (abs(goal.x) <= area / 1000.0 and abs(goal.y) <= area / 1000.0):
+            raise invalid(f"{what} ({1000.0 * goal.x:.6g}, {1000.0 * goal.y:.6g}) mm is outside "
+                          f"the work area (±{area:g} mm in x and y)")
+        return goal
+
+    def _check_rotation(self, angle: float, what: str) -> None:
+        limit = self.config.turn_limit
+        if not abs(math.degrees(angle)) <= limit:
+            raise invalid(f"{what} is {math.degrees(angle):.6g} degree: at most ±{limit:g} degree")
+
+    def _limits(self, velocity: tuple[float, float] | None = None,
+                acceleration: tuple[float, float] | None = None) -> tuple[float, float, float, float]:
         """The velocity and acceleration settings in SI: (v, w, a, alpha)."""
-        (vt, vr), (at, ar) = self.velocity, self.acceleration
+        (vt, vr), (at, ar) = velocity or self.velocity, acceleration or self.acceleration
         return vt / 1000.0, math.radians(vr), at / 1000.0, math.radians(ar)
 
-    def _submit(self, plan: Callable[[Pose2D], Path], label: str) -> dict:
+    def _splice_time(self, device: Device, motion: TrackedBaseMotion, attempt: int) -> float:
+        """Motion time at which a plan made now takes over: a little ahead of the device, the
+        further the more often it outran the planner."""
+        ahead = LOOKAHEAD_STEPS * self._dt * LOOKAHEAD_GROWTH ** attempt
+        return max(device.t + ahead, motion.t0)
+
+    def _edit(self, look: Callable[[Device, int], Any], plan: Callable[[Any], Any]) -> Any:
+        out = self.device.edit_planned(look, plan)
+        if out is STALE:
+            raise VehicleRefused(AlarmCode.WRONG_STATE,
+                                 "the base changed faster than the new path could be planned: "
+                                 "call again")
+        return out
+
+    @staticmethod
+    def _running(device: Device) -> Any:
+        """The motion a jog or a continuous move would re-plan: the running tracked motion,
+        unless a stop decelerates it (then a new motion is submitted, and discarded)."""
+        cur = device.current
+        if cur is None or device.stopping or not isinstance(cur.motion, TrackedBaseMotion):
+            return None
+        return cur
+
+    def _discard_not_started(self, device: Device) -> None:
+        """Commit of a take-over when no tracked motion runs: the moves accepted but not
+        started (or queued behind a brake) give way; the new one is then submitted."""
+        if not device.stopping:
+            device.discard_queue()
+            self._op_generation = device.generation     # this operation's own discard
+
+    def _take_over(self, device: Device, cur: Any, t: float, path: Path, label: str) -> Any:
+        """Commit: the running motion follows `path` from motion time t as a `label` motion;
+        what was queued behind it was planned from its old end and is discarded."""
+        if device.t > t:
+            return STALE
+        self._admit(SERVO_ON, label, device)
+        device.discard_queue()
+        self._op_generation = device.generation         # this operation's own discard
+        cur.motion = cur.motion.handover(t, path, label)
+        cur.label = label
+        return cur.id
+
+    def _submit(self, plan: Callable[[Pose2D], Path], label: str,
+                allowed: tuple[VehicleState, ...]) -> dict:
         """Queue a tracked motion along plan(start of the motion)."""
         odometry = self.odometry
         return self._submit_motion(lambda start: TrackedBaseMotion(odometry, plan(start), label),
-                                   label)
+                                   label, allowed)
 
-    def _submit_motion(self, make: Callable[[Pose2D], Any], label: str) -> dict:
-        motion_id = self.device.submit(make, label)
+    def _submit_motion(self, make: Callable[[Pose2D], Any], label: str,
+                       allowed: tuple[VehicleState, ...]) -> dict:
+        """Plan from the end of the queue (under no lock) and queue it; planned again if a stop
+        or another change came in meanwhile, checked against the state then."""
+        def plan(start: Pose2D) -> Any:
+            with self.lock:
+                self._admit(allowed, label, self.device)
+            return make(start)
+        motion_id = self.device.submit(plan, label)
         if motion_id is None:
             raise VehicleRefused(AlarmCode.QUEUE_FULL,
                                  f"the motion queue is full ({self.device.capacity} motions)")
@@ -586,71 +637,121 @@ class VehicleCore:
         return {"motion_id": motion_id}
 
     def _drive(self, target: tuple[float, float], hold: float, accel: tuple[float, float],
-               label: str) -> dict:
-        """Velocity drive: re-plan the running jog/joystick motion from where its reference is
-        now (speed continuous), or start one on an idle base; refused behind queued moves."""
-        def plan(start: Pose2D, v0: float = 0.0, w0: float = 0.0) -> Path:
-            return velocity_path(start, v0, w0, target, hold, accel)
+               label: str, take_over: bool) -> dict:
+        """Velocity drive: re-plan the running jog/joystick motion from its reference a little
+        ahead of now (speed continuous), take over another running move (`take_over`, else
+        refused), or start one on an idle base. The deadman ends it `hold` s of wall time from
+        now unless called again."""
+        def look(device: Device, attempt: int):
+            cur = self._running(device)
+            if not take_over and (device.queue or cur is not None and cur.label not in VELOCITY_DRIVEN):
+                raise self._busy(label)
+            return None if cur is None else (cur, self._splice_time(device, cur.motion, attempt))
 
-        def update(device: Device) -> int | None:
-            cur = device.current
-            if cur is not None and not device.queue and not device.stopping \
-                    and cur.label in VELOCITY_DRIVEN:
-                t = device.t
-                cur.motion.splice(t, plan(cur.motion.at(t), *cur.motion.reference_twist(t)))
-                cur.label = label
-                return cur.id
-            if device.busy and not (cur is not None and device.stopping and not device.queue):
-                raise VehicleRefused(AlarmCode.WRONG_STATE,
-                                     f"the base is busy with queued moves: {label} drives only an "
-                                     "idle base (wait, or call stop)")
-            return None
-        motion_id = self.device.edit(update)
+        def plan(seen):
+            if seen is None:
+                return self._discard_not_started if take_over else (lambda device: None)
+            cur, t = seen
+            motion = cur.motion
+            path = velocity_path(motion.at(t), *motion.reference_twist(t), target, hold, accel)
+
+            def commit(device: Device) -> Any:
+                out = self._take_over(device, cur, t, path, label)
+                if out is not STALE:
+                    self._arm_deadman(hold, target)
+                return out
+            return commit
+        motion_id = self._edit(look, plan)
         if motion_id is None and target == (0.0, 0.0):
             return {"motion_id": 0}                  # standing still already: nothing to queue
         if motion_id is None:
-            return self._submit(plan, label)
+            self._arm_deadman(hold, target)          # before the simulation can pick it up
+            return self._submit(lambda start: velocity_path(start, 0.0, 0.0, target, hold, accel),
+                                label, SERVO_ON)
         self._accepted_motion()
         return {"motion_id": motion_id}
+
+    @staticmethod
+    def _busy(label: str) -> VehicleRefused:
+        return VehicleRefused(AlarmCode.WRONG_STATE,
+                              f"the base is busy with other moves: {label} drives only an idle "
+                              "base (wait, or call stop)")
+
+    def _arm_deadman(self, hold: float, target: tuple[float, float]) -> None:
+        """The drive ends `hold` s of wall time from now; a drive to rest ends by itself."""
+        self._drive_deadline = time.monotonic() + hold if target != (0.0, 0.0) else math.inf
+        self._deadman_fired = None
 
     def _accepted_motion(self) -> None:
         self.stuck = False
         self.alarms.clear(Kind.STUCK)
 
-    def _retime(self) -> None:
-        """Apply new settings to the running motion (from now on) and to the queued ones."""
-        limits = self._limits()
+    def _retime(self, velocity: tuple[float, float], acceleration: tuple[float, float]) -> None:
+        """Plan new settings for the running motion (a little ahead of now) and the queued
+        ones, off the device's lock; commit them together. Velocity drives keep their speeds."""
+        limits = self._limits(velocity, acceleration)
 
-        def retime(device: Device) -> None:
-            cur = device.current
-            if cur is not None and not device.stopping and hasattr(cur.motion, "retime"):
-                cur.motion.retime(device.t, limits)
-            for queued in device.queue:
-                if hasattr(queued.motion, "retime"):
-                    queued.motion.retime(0.0, limits)
-        self.device.edit(retime)
+        def look(device: Device, attempt: int):
+            cur, items = device.current, []
+            if cur is not None and not device.stopping and hasattr(cur.motion, "replan") \
+                    and cur.label not in VELOCITY_DRIVEN:
+                items.append((cur.motion, self._splice_time(device, cur.motion, attempt)))
+            running = len(items)
+            items += [(q.motion, 0.0) for q in device.queue if hasattr(q.motion, "replan")]
+            return items, running
 
-    def _reference_twist(self) -> tuple[float, float]:
-        cur = self.device.current
+        def plan(seen):
+            items, running = seen
+            changes = [m.replan(t, limits) for m, t in items]
+
+            def commit(device: Device) -> None:
+                if running and device.t > items[0][1]:
+                    return STALE
+                for change in changes:
+                    if change is not None:
+                        change()
+            return commit
+        self._edit(look, plan)
+
+    def _ramp(self, accel: tuple[float, float], up: bool) -> float:
+        """Time for the device's rate to ramp from 1 to 0 (pause, stop) or from 0 to 1 (`up`,
+        resume) at `accel` (mm/s², degree/s²). Speed = rate × path speed, so where the path
+        itself slows down (or, ramping up, speeds up) just now, its own acceleration adds to the
+        ramp's: the ramp takes only what is left of `accel` beside it (at least a quarter); and
+        stopping takes down the highest speed the path reaches meanwhile."""
+        device, dt = self.device, self._dt
+        cur = device.current
         if cur is None or not hasattr(cur.motion, "reference_twist"):
-            return self.odometry.v, self.odometry.w
-        return cur.motion.reference_twist(self.device.t)
+            def twist(_: float) -> tuple[float, float]:
+                return self.odometry.v, self.odometry.w
+        else:
+            def twist(t: float) -> tuple[float, float]:
+                return cur.motion.reference_twist(t)
+        t = device.t
+        now, later = twist(t), twist(t + dt)
+        ramp = 0.02
+        for i, a in enumerate((accel[0] / 1000.0, math.radians(accel[1]))):
+            change = (abs(later[i]) - abs(now[i])) / dt
+            adds = max(0.0, change if up else -change)
+            speed = abs(now[i])
+            if not up and change > 0.0:            # the path still speeds up while it stops
+                span = speed * (1.0 + change / a) / a
+                speed = max(abs(twist(t + span * k / 8)[i]) for k in range(9))
+            ramp = max(ramp, speed / max(a - adds, a / 4))
+        return ramp
 
     def _stop_ramp(self) -> float:
         """Time to stop from the present speed at the maximum acceleration."""
         c = self.config
-        v, w = self._reference_twist()
-        return max(abs(v) * 1000.0 / c.accel_limit_translation,
-                   math.degrees(abs(w)) / c.accel_limit_rotation, 0.02)
+        return self._ramp((c.accel_limit_translation, c.accel_limit_rotation), up=False)
 
     def _resume_ramp(self) -> float:
-        v, w = self._reference_twist()
-        (at, ar) = self.acceleration
-        return max(abs(v) * 1000.0 / at, math.degrees(abs(w)) / ar, 0.02)
+        return self._ramp(self.acceleration, up=True)
 
     def _stop(self) -> None:
         cur = self.device.current
         if cur is not None and isinstance(cur.motion, BrakeMotion):
+            self.device.edit(Device.discard_queue)
             return
         self.device.stop(self._stop_ramp())
 
@@ -660,64 +761,3 @@ class VehicleCore:
         self.device.halt(self.odometry.pose)
         decel = (c.accel_limit_translation / 1000.0, math.radians(c.accel_limit_rotation))
         self.device.submit(lambda start: BrakeMotion(self.odometry, decel), "brake")
-
-    # --- the simulation thread --------------------------------------------------------------
-    def _sense(self, world: World) -> None:
-        """Each step before the devices move: odometry, battery, contact and blockage."""
-        self.odometry.update(world.wheel_positions(), self._dt)
-        if self.device.current is None:
-            world.set_wheel_velocities(0.0, 0.0)
-        self._drain_battery()
-        self._contact = contact = world.bumper_in_contact()
-        if not contact:
-            self._contact_armed = True
-        elif self.digital_sensor_lock and self._contact_armed and not self.locked:
-            with self.lock:
-                self._contact_armed = False
-                self.locked = True
-                self.alarms.raise_(AlarmCode.CONTACT, "contact sensor: the bumper touched something",
-                                   Kind.CONTACT)
-                self._halt()
-        self._watch_tracking(world.time)
-
-    def _watch_tracking(self, now: float) -> None:
-        cur = self.device.current
-        c = self.config
-        if cur is None or isinstance(cur.motion, BrakeMotion) or self.device.paused:
-            self._stuck_since = None
-            return
-        dist, angle = cur.motion.error
-        if dist * 1000.0 < c.stuck_error and abs(math.degrees(angle)) < c.stuck_angle:
-            self._stuck_since = None
-            return
-        if self._stuck_since is None:
-            self._stuck_since = now
-        elif now - self._stuck_since >= c.stuck_time:
-            with self.lock:
-                self._stuck_since = None
-                self.stuck = True
-                self.alarms.raise_(AlarmCode.STUCK,
-                                   f"the base could not follow its path ({1000 * dist:.0f} mm, "
-                                   f"{math.degrees(angle):.1f}° off): stopped", Kind.STUCK)
-                self._halt()
-
-    def _drain_battery(self) -> None:
-        if not self.power:
-            self.battery.drain(0.0, self._dt)
-            return
-        v, w, b = self.odometry.v, self.odometry.w, self.odometry.b
-        wheels = abs(v - w * b / 2) + abs(v + w * b / 2)
-        drive = DRIVE_LOSS_N * wheels / 2 / DRIVE_EFFICIENCY
-        self.battery.drain(POWER_IDLE_W + (POWER_SERVO_W if self.servo else 0.0) + drive, self._dt)
-        voltage, c = self.battery.voltage, self.config
-        if voltage < c.battery_low_voltage and not self.alarms.has(AlarmCode.BATTERY_LOW):
-            self.alarms.raise_(AlarmCode.BATTERY_LOW,
-                               f"battery low: {voltage:.1f} V (below {c.battery_low_voltage:g} V)",
-                               Kind.CONDITION)
-        if voltage < c.battery_cutoff_voltage and not self.alarms.has(AlarmCode.BATTERY_EMPTY):
-            with self.lock:
-                self.alarms.raise_(AlarmCode.BATTERY_EMPTY,
-                                   f"battery exhausted: {voltage:.1f} V (below "
-                                   f"{c.battery_cutoff_voltage:g} V): servo off", Kind.CONDITION)
-                self._stop()
-                self.servo = False

@@ -11,7 +11,7 @@ import bisect
 import math
 import threading
 from dataclasses import dataclass
-from typing import Protocol, Sequence
+from typing import Callable, Protocol, Sequence
 
 import numpy as np
 
@@ -239,7 +239,7 @@ def arc(start: Pose2D, centre_y: float, angle: float,
 
 
 class Chain:
-    """Paths one after the other (each starts where the previous one ends, at rest)."""
+    """Paths one after the other (each starts where the previous one ends, with its speed)."""
 
     def __init__(self, paths: Sequence[Path], start: Pose2D) -> None:
         self.paths = [p for p in paths if p.duration > 0.0]
@@ -247,10 +247,13 @@ class Chain:
         self.starts = list(np.cumsum([0.0] + [p.duration for p in self.paths]))
         self.duration = self.starts[-1]
 
+    def _index(self, t: float) -> int:
+        return min(max(bisect.bisect_right(self.starts, t) - 1, 0), len(self.paths) - 1)
+
     def _find(self, t: float) -> tuple[Path | None, float]:
         if not self.paths:
             return None, 0.0
-        i = min(max(bisect.bisect_right(self.starts, t) - 1, 0), len(self.paths) - 1)
+        i = self._index(t)
         return self.paths[i], t - self.starts[i]
 
     def pose(self, t: float) -> Pose2D:
@@ -263,11 +266,20 @@ class Chain:
         path, tau = self._find(t)
         return path.twist(tau)
 
+    def head(self, t: float) -> "list[Path] | None":
+        """The parts that make the path up to time t (the last one cut there), or None when
+        the part running at t cannot be cut."""
+        if not self.paths or not 0.0 < t < self.duration:
+            return None
+        i = self._index(t)
+        cut = getattr(self.paths[i], "head", None)
+        return None if cut is None else self.paths[:i] + [cut(t - self.starts[i])]
+
     def retimed(self, t: float, limits: Limits) -> "Chain":
         """The running part re-timed from its present speed, the parts after it from rest."""
         if not self.paths:
             return self
-        i = min(max(bisect.bisect_right(self.starts, t) - 1, 0), len(self.paths) - 1)
+        i = self._index(t)
         head = self.paths[i]
         parts = [retimed_or_kept(head, t - self.starts[i], limits)]
         parts += [retimed_or_kept(p, 0.0, limits) for p in self.paths[i + 1:]]
@@ -363,23 +375,49 @@ class SampledPath:
                 float(self.w[i] + f * (self.w[i + 1] - self.w[i])))
 
 
-def velocity_path(start: Pose2D, v0: float, w0: float, target: tuple[float, float], hold: float,
-                  accel: tuple[float, float], dt: float = 0.005) -> SampledPath:
-    """Drive like a jog: from speed (v0, w0) slew to `target` (v, w) at `accel` (a, alpha), keep it
-    until `hold` s, then slew to rest. With hold = 0 and target (0, 0) it is a brake."""
+    def head(self, t: float) -> "SampledPath":
+        """The path up to time t (0 < t < duration), ending with the state there."""
+        i, f = self._index(t)
+        cut = lambda a: np.append(a[:i + 1], a[i] + f * (a[i + 1] - a[i]))  # noqa: E731
+        return SampledPath(*(cut(a) for a in (self.t, self.x, self.y, self.theta, self.v, self.w)))
+
+
+class ConstantTwist:
+    """Driving at a constant (forward speed, yaw rate) for `duration` s: a line, an arc or a turn."""
+
+    def __init__(self, start: Pose2D, twist: tuple[float, float], duration: float) -> None:
+        self.start, (self.v, self.w), self.duration = start, twist, max(0.0, duration)
+
+    def pose(self, t: float) -> Pose2D:
+        t = min(max(t, 0.0), self.duration)
+        v, w = self.v * t, self.w * t
+        if abs(w) < 1e-12:
+            return self.start.forward(v)
+        r = v / w
+        return self.start.compose(Pose2D(r * math.sin(w), r * (1 - math.cos(w)), w))
+
+    def twist(self, t: float) -> tuple[float, float]:
+        return (self.v, self.w) if 0.0 <= t < self.duration else (0.0, 0.0)
+
+
+SLEW_SAMPLES = 2000          # at most this many samples per speed change of a velocity drive
+SLEW_DT = 0.005              # s between them, unless that would need more
+
+
+def slew(start: Pose2D, v0: float, w0: float, goal: tuple[float, float],
+         accel: tuple[float, float], longest: float = math.inf) -> SampledPath:
+    """Change speed from (v0, w0) to `goal` at `accel` (a, alpha), for at most `longest` s."""
     a, alpha = accel
+    span = min(longest, max(abs(goal[0] - v0) / a, abs(goal[1] - w0) / alpha))
+    dt = max(SLEW_DT, span / SLEW_SAMPLES)
     ts, xs, ys, ths, vs, ws = [0.0], [start.x], [start.y], [start.theta], [v0], [w0]
     t, x, y, th, v, w = 0.0, start.x, start.y, start.theta, v0, w0
 
-    def slew(cur: float, goal: float, rate: float) -> float:
+    def toward(cur: float, target: float, rate: float) -> float:
         step = rate * dt
-        return goal if abs(goal - cur) <= step else cur + math.copysign(step, goal - cur)
-    limit = hold + abs(v0) / a + abs(w0) / alpha + abs(target[0]) / a + abs(target[1]) / alpha + 1.0
-    while t < limit:
-        goal = target if t < hold else (0.0, 0.0)
-        if t >= hold and v == 0.0 and w == 0.0:
-            break
-        v1, w1 = slew(v, goal[0], a), slew(w, goal[1], alpha)
+        return target if abs(target - cur) <= step else cur + math.copysign(step, target - cur)
+    while t < span - 1e-12 and (v, w) != tuple(goal):
+        v1, w1 = toward(v, goal[0], a), toward(w, goal[1], alpha)
         vm, wm = (v + v1) / 2, (w + w1) / 2
         mid = th + wm * dt / 2
         x, y, th = x + vm * dt * math.cos(mid), y + vm * dt * math.sin(mid), th + wm * dt
@@ -394,13 +432,28 @@ def velocity_path(start: Pose2D, v0: float, w0: float, target: tuple[float, floa
     return SampledPath(*(np.array(a_) for a_ in (ts, xs, ys, ths, vs, ws)))
 
 
+def velocity_path(start: Pose2D, v0: float, w0: float, target: tuple[float, float], hold: float,
+                  accel: tuple[float, float]) -> Chain:
+    """Drive like a jog: from speed (v0, w0) slew to `target` (v, w) at `accel` (a, alpha), keep it
+    until `hold` s, then slew to rest. With hold = 0 and target (0, 0) it is a brake. Its cost
+    does not grow with `hold` or with how slow the acceleration is."""
+    up = slew(start, v0, w0, target, accel, hold)
+    end = up.pose(up.duration)
+    v, w = (float(up.v[-1]), float(up.w[-1])) if len(up.t) > 1 else (v0, w0)
+    keep = ConstantTwist(end, (v, w), hold - up.duration)
+    down = slew(keep.pose(keep.duration), v, w, (0.0, 0.0), accel)
+    return Chain([up, keep, down], start)
+
+
 # --- motions ---------------------------------------------------------------------------------
 class TrackedBaseMotion:
     """A base motion along a reference path: feed-forward twist plus feedback on the odometry
     error (Kanayama's tracking law), then a short settle so the base ends on the target.
 
-    The path runs from motion time `t0`; `splice(t, path)` makes `path` the reference from t on.
-    `error` is the latest tracking error (m, rad), for blocked-base detection.
+    The reference is a list of (motion time, path) segments: `splice(t, path)` makes `path` the
+    reference from t on, also from a time still ahead (a plan made outside the device's lock
+    takes over a little after now; until then the old reference runs). `error` is the latest
+    tracking error (m, rad), for blocked-base detection.
     """
 
     SETTLE = 0.4
@@ -408,10 +461,18 @@ class TrackedBaseMotion:
 
     def __init__(self, odometry: Odometry, path: Path, kind: str = "") -> None:
         self.odometry = odometry
-        self.path = path
-        self.t0 = 0.0
+        self.segments: list[tuple[float, Path]] = [(0.0, path)]
         self.kind = kind
         self.error = (0.0, 0.0)
+
+    @property
+    def path(self) -> Path:
+        """The last reference: the one the motion ends on."""
+        return self.segments[-1][1]
+
+    @property
+    def t0(self) -> float:
+        return self.segments[-1][0]
 
     @property
     def duration(self) -> float:
@@ -422,29 +483,51 @@ class TrackedBaseMotion:
         """Motion time at which the reference stops (the settle follows)."""
         return self.t0 + self.path.duration
 
+    def _segment(self, t: float) -> tuple[float, Path]:
+        for t0, path in reversed(self.segments):
+            if t >= t0:
+                return t0, path
+        return self.segments[0]
+
     def at(self, t: float) -> Pose2D:
-        return self.path.pose(min(max(t - self.t0, 0.0), self.path.duration))
+        t0, path = self._segment(t)
+        return path.pose(min(max(t - t0, 0.0), path.duration))
 
     def reference_twist(self, t: float) -> tuple[float, float]:
-        return self.path.twist(t - self.t0)
+        t0, path = self._segment(t)
+        return path.twist(t - t0)
 
     def splice(self, t: float, path: Path) -> None:
-        """Follow `path` (which starts at the reference state at t) from motion time t on; what
-        came before t is never asked for again (the device only looks ahead)."""
-        self.path, self.t0 = path, t
+        """Follow `path` (which starts at the reference state at t) from motion time t on."""
+        self.segments = [s for s in self.segments if s[0] < t] + [(t, path)]
+
+    def handover(self, t: float, path: Path, kind: str) -> "TrackedBaseMotion":
+        """A plain tracked motion of another kind that follows this one's reference until t and
+        `path` from then on (a continuous move or a jog taking over a running move)."""
+        other = TrackedBaseMotion(self.odometry, path, kind)
+        other.segments = list(self.segments)
+        other.splice(t, path)
+        return other
 
     def move_frame(self, frame: Pose2D) -> None:
-        self.path = Moved(self.path, frame)
+        self.segments = [(t0, Moved(path, frame)) for t0, path in self.segments]
 
-    def retime(self, t: float, limits: Limits) -> None:
-        """New velocity or acceleration settings from motion time t on (0: not started)."""
+    def replan(self, t: float, limits: Limits) -> "Callable[[], None] | None":
+        """New velocity or acceleration settings from motion time t on (0: not started): the
+        new timing, planned now; calling the result applies it (under the device's lock)."""
         local = max(0.0, t - self.t0)
-        if local < self.path.duration:
-            new = getattr(self.path, "retimed", lambda *_: None)(local, limits)
-            if new is not None:
-                self.splice(max(t, self.t0), new)
+        if local >= self.path.duration:
+            return None
+        new = getattr(self.path, "retimed", lambda *_: None)(local, limits)
+        if new is None:
+            return None
+        at = max(t, self.t0)
+        return lambda: self.splice(at, new)
 
     def apply(self, world: World, t: float, rate: float) -> None:
+        if len(self.segments) > 1 and t >= self.segments[1][0]:      # forget what is behind
+            self.segments = [s for i, s in enumerate(self.segments)
+                             if i + 1 == len(self.segments) or self.segments[i + 1][0] > t]
         if t >= self.duration:
             world.set_wheel_velocities(0.0, 0.0)
             return
