@@ -7,12 +7,12 @@ from dataclasses import dataclass
 
 import rclpy
 from builtin_interfaces.msg import Time
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
 from acti_bringup.parameters import declare_config
+from acti_bringup.spinning import Planes, wait_for_signal
 from acti_motion.executor import MotionExecutor
 from acti_sim.world import World
 
@@ -62,22 +62,24 @@ class Simulation:
         self._joints.publish(msg)
 
     def spin(self, *nodes: Node) -> None:
-        """Run the simulation and serve the nodes until SIGINT/SIGTERM, then clean up."""
-        executor = MultiThreadedExecutor(num_threads=6)
-        for n in nodes:
-            executor.add_node(n)
+        """Run the simulation and serve the nodes (each on the control plane, its `motion` plane
+        node on the motion plane: `acti_bringup.spinning`) until SIGINT/SIGTERM, then clean up."""
+        planes = Planes()
+        motion = [n.motion for n in nodes if hasattr(n, "motion")]
+        planes.add(nodes, motion)
         self.executor.start()
+        planes.start()
         try:
-            executor.spin()
-        except (KeyboardInterrupt, ExternalShutdownException):
-            pass
+            wait_for_signal(planes.serving)
         finally:
             self.executor.shutdown()
-            executor.shutdown()
-            for n in nodes:
+            planes.stop()
+            for n in (*motion, *nodes):
                 n.destroy_node()
             self.world.close()
             rclpy.try_shutdown()
+        for error in planes.errors():
+            raise error
 
 
 def run_alone(node_class: type, args: list[str] | None = None) -> None:

@@ -7,10 +7,9 @@ from typing import Any
 
 import pinocchio as pin
 from acti_msgs.msg import Alarm, ArmState, ReturnId
-from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
-from acti_bringup.adapter import serve_operations
+from acti_bringup.adapter import MotionPlane, serve_operations
 from acti_bringup.parameters import declare_config
 from acti_bringup.simulation import Simulation
 from acti_middle_node.actions import ActionConfig, MotionActions
@@ -37,17 +36,17 @@ class ArmNode(Node):
         super().__init__("acti_middle_node")
         self.simulation = simulation or Simulation(self)
         self.core = ArmCore(self.simulation.executor, declare_config(self, ArmConfig))
-        serve_operations(self, self.core, OPERATIONS, write_return_id)
-        group = ReentrantCallbackGroup()
+        self.motion = MotionPlane(self)
+        serve_operations(self, self.motion, self.core, OPERATIONS, write_return_id)
         actions = declare_config(self, ActionConfig)
         topics = declare_config(self, TopicConfig)
         if actions.feedback_rate_hz <= 0 or topics.state_rate_hz <= 0:
             raise ValueError("feedback_rate_hz and state_rate_hz must be > 0")
-        self.actions = MotionActions(self, self.core, group, actions)
-        self.programs = ProgramAction(self, self.core, group, actions.feedback_rate_hz,
+        self.actions = MotionActions(self.motion, self.core, actions)
+        self.programs = ProgramAction(self.motion, self.core, actions.feedback_rate_hz,
                                       declare_config(self, ProgramDefaults))
         self._state = self.create_publisher(ArmState, "~/state", 10)
-        self.create_timer(1.0 / topics.state_rate_hz, self._publish_state, callback_group=group)
+        self.create_timer(1.0 / topics.state_rate_hz, self._publish_state)
 
     def _publish_state(self) -> None:
         core = self.core

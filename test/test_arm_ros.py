@@ -45,8 +45,7 @@ class Actions:
         assert self.client.wait_for_server(timeout_sec=30.0)
 
     def spin(self, future, timeout=ACTION_TIMEOUT):
-        self.ros.executor.spin_until_future_complete(future, timeout_sec=timeout)
-        assert future.done(), "no answer in time"
+        assert self.ros.wait(future, timeout), "no answer in time"
         return future.result()
 
     def send(self, feedback=None, **fields):

@@ -21,7 +21,7 @@ from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from sensor_msgs.msg import Joy
 
-from acti_bringup.adapter import serve_operations
+from acti_bringup.adapter import MotionPlane, serve_operations
 from acti_bringup.parameters import declare_config
 from acti_bringup.simulation import Simulation
 from acti_motion.vehicle.paths import Pose2D
@@ -62,14 +62,16 @@ class VehicleNode(Node):
         super().__init__("vehicle_node")
         self.simulation = simulation or Simulation(self)
         self.core = VehicleCore(self.simulation.executor, declare_config(self, VehicleConfig))
-        serve_operations(self, self.core, OPERATIONS, write_success)
-        self.wait_motion = WaitMotionServer(self, self.core, declare_config(self, WaitConfig))
+        self.motion = MotionPlane(self)
+        serve_operations(self, self.motion, self.core, OPERATIONS, write_success)
+        self.wait_motion = WaitMotionServer(self.motion, self.core, declare_config(self, WaitConfig))
         self._odom = self.create_publisher(Odometry, "odom", 10)
         self._truth = self.create_publisher(Odometry, "~/ground_truth", 10)
         self._state = self.create_publisher(VehicleStatus, "~/state", 10)
         self._diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
-        self.create_subscription(Twist, "cmd_vel", self._on_cmd_vel, 10)
-        self.create_subscription(Joy, "joy", self._on_joy, 10)
+        # commands that move the base arrive on the motion plane, like the move services
+        self.motion.create_subscription(Twist, "cmd_vel", self._on_cmd_vel, 10)
+        self.motion.create_subscription(Joy, "joy", self._on_joy, 10)
         rate = self.simulation.config.rate_hz
         ex = self.simulation.executor
         ex.after_step(self._publish_odometry, every=max(1, round(rate / ODOM_RATE_HZ)))

@@ -1,0 +1,106 @@
+"""How a process serves its nodes: two planes, each on an executor and a thread of its own.
+
+- The control plane (stop, pause, resume, servo, get_state, the getters and setters, parameters,
+  the timers and topics) runs on rclpy's `EventsExecutor`: it keeps no wait set to rebuild on
+  every wake (48 % of the GIL under a getter storm with the MultiThreadedExecutor), so a call
+  costs about what a bare node's does. Nothing on it plans or waits.
+- The motion plane (the services that plan a move, action goals, cmd_vel/joy) runs on a
+  `SingleThreadedExecutor` (goals are coroutines that await; the EventsExecutor would poll them
+  without pause): planning for ms there never delays the control plane.
+
+Each executor is driven by a `spin_once` loop (the EventsExecutor's `spin()` serves nothing in
+this rclpy and neither honours SIGINT); SIGINT and SIGTERM are handled here, on the main thread.
+"""
+from __future__ import annotations
+
+import signal
+import threading
+from typing import Any, Callable, Iterable
+
+import rclpy
+from rclpy.executors import Executor, SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
+from rclpy.node import Node
+
+SPIN_TIMEOUT_S = 0.5        # a loop's longest sleep: how soon it notices it should end
+SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+class SpinLoop:
+    """One executor served by `spin_once` on a thread of its own until `stop()`."""
+
+    def __init__(self, executor: Executor, name: str) -> None:
+        self.executor, self.name = executor, name
+        self.error: BaseException | None = None
+        self._running = threading.Event()
+        self._thread = threading.Thread(target=self._loop, name=name, daemon=True)
+
+    def start(self) -> "SpinLoop":
+        self._running.set()
+        self._thread.start()
+        return self
+
+    @property
+    def alive(self) -> bool:
+        return self._thread.is_alive()
+
+    def _loop(self) -> None:
+        context = self.executor.context
+        try:
+            while self._running.is_set() and context.ok():
+                self.executor.spin_once(timeout_sec=SPIN_TIMEOUT_S)
+        except BaseException as e:  # ends the process's serving: the main thread reports it
+            if context.ok() and self._running.is_set():
+                self.error = e
+
+    def stop(self) -> None:
+        self._running.clear()
+        self.executor.wake()
+        self._thread.join(timeout=5.0)
+
+
+class Planes:
+    """The control and motion executors of one process and their loops."""
+
+    def __init__(self) -> None:
+        self.control = EventsExecutor()
+        self.motion = SingleThreadedExecutor()
+        self._loops: list[SpinLoop] = []
+
+    def add(self, control: Iterable[Node], motion: Iterable[Node]) -> None:
+        for n in control:
+            self.control.add_node(n)
+        for n in motion:
+            self.motion.add_node(n)
+
+    def start(self) -> None:
+        self._loops = [SpinLoop(self.control, "ros-control").start(),
+                       SpinLoop(self.motion, "ros-motion").start()]
+
+    def serving(self) -> bool:
+        return all(loop.alive for loop in self._loops)
+
+    def errors(self) -> list[BaseException]:
+        return [loop.error for loop in self._loops if loop.error is not None]
+
+    def stop(self) -> None:
+        for loop in self._loops:
+            loop.stop()
+        self.motion.shutdown(timeout_sec=5.0)
+        self.control.shutdown(timeout_sec=5.0)
+
+
+def wait_for_signal(still_serving: Callable[[], bool]) -> None:
+    """Block the main thread until SIGINT/SIGTERM (or until `still_serving()` says no).
+
+    Installed after the executors exist, so these handlers replace any they or rclpy.init put in.
+    """
+    stop = threading.Event()
+
+    def on_signal(_signum: int, _frame: Any) -> None:
+        stop.set()
+    for s in SIGNALS:
+        signal.signal(s, on_signal)
+    while not stop.wait(SPIN_TIMEOUT_S):
+        if not (still_serving() and rclpy.ok()):
+            return
