@@ -1,6 +1,6 @@
 """Table-driven service registration: one row per IDL operation, one core method per row.
 
-Operations that plan a motion are served by the device's motion plane (`MotionPlane`), every
+Operations that plan a motion are served by the device's motion plane (a `Plane` node), every
 other one by the device node itself on the control plane (see `acti_bringup.spinning`): a move
 planning for milliseconds never delays stop, pause or get_state. Clients see one node's services
 either way (`/<ns>/<node>/<operation>`).
@@ -32,15 +32,16 @@ class Operation:
         return self.name.startswith(PLANNING)
 
 
-class MotionPlane(Node):
-    """The node that holds a device's planning services, its action servers and its command
-    topics, served by the process's motion executor. It is an implementation detail (hidden
-    name, no parameters of its own): its entities are named under the device node."""
+class Plane(Node):
+    """A node that holds part of a device node's entities so that another executor serves them
+    (`acti_bringup.spinning`): "motion" (planning services, command topics) or "goals" (action
+    servers). An implementation detail (hidden name, no parameters of its own): its services
+    and actions are named under the device node."""
 
-    def __init__(self, owner: Node) -> None:
-        super().__init__(f"_{owner.get_name()}_motion", namespace=owner.get_namespace(),
+    def __init__(self, owner: Node, plane: str) -> None:
+        super().__init__(f"_{owner.get_name()}_{plane}", namespace=owner.get_namespace(),
                          start_parameter_services=False)
-        self.owner = owner
+        self.owner, self.plane = owner, plane
 
     def name(self, entity: str) -> str:
         """`~/entity` of the device node, as an absolute name."""
@@ -50,7 +51,7 @@ class MotionPlane(Node):
 StatusWriter = Callable[[Any, Reply], None]
 
 
-def serve_operations(node: Node, motion: MotionPlane, core: Any,
+def serve_operations(node: Node, motion: Plane, core: Any,
                      operations: tuple[Operation, ...], write_status: StatusWriter) -> list:
     """Create `~/<name>` for every row, calling `core.<name>(**request fields)`: on `motion`
     for the rows that plan, on `node` for the others."""

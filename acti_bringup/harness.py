@@ -15,15 +15,15 @@ CALL_TIMEOUT = 30.0
 
 
 class NodeProcess:
-    """`python -m <module>` with --ros-args; stopped by PID (SIGINT, then SIGKILL)."""
+    """`python -m <module> [args] --ros-args -p <params>`; stopped by PID (SIGINT, then SIGKILL)."""
 
-    def __init__(self, module: str, log_path: str, *params: str) -> None:
-        args = [sys.executable, "-m", module, "--ros-args"]
+    def __init__(self, module: str, log_path: str, *params: str, args: tuple[str, ...] = ()) -> None:
+        command = [sys.executable, "-m", module, *args, "--ros-args"]
         for p in params:
-            args += ["-p", p]
+            command += ["-p", p]
         self.log_path = log_path
         self._log = open(log_path, "w")
-        self.proc = subprocess.Popen(args, cwd=ROOT, stdout=self._log, stderr=subprocess.STDOUT)
+        self.proc = subprocess.Popen(command, cwd=ROOT, stdout=self._log, stderr=subprocess.STDOUT)
 
     def alive(self) -> bool:
         return self.proc.poll() is None

@@ -62,11 +62,14 @@ class Simulation:
         self._joints.publish(msg)
 
     def spin(self, *nodes: Node) -> None:
-        """Run the simulation and serve the nodes (each on the control plane, its `motion` plane
-        node on the motion plane: `acti_bringup.spinning`) until SIGINT/SIGTERM, then clean up."""
+        """Run the simulation and serve the nodes until SIGINT/SIGTERM, then clean up: each node
+        on the control plane, its `motion` and `goals` plane nodes on theirs
+        (`acti_bringup.spinning`)."""
         planes = Planes()
-        motion = [n.motion for n in nodes if hasattr(n, "motion")]
-        planes.add(nodes, motion)
+        planes.add("control", nodes)
+        helpers = [getattr(n, plane) for plane in ("motion", "goals") for n in nodes]
+        for helper in helpers:
+            planes.add(helper.plane, [helper])
         self.executor.start()
         planes.start()
         try:
@@ -74,7 +77,7 @@ class Simulation:
         finally:
             self.executor.shutdown()
             planes.stop()
-            for n in (*motion, *nodes):
+            for n in (*helpers, *nodes):
                 n.destroy_node()
             self.world.close()
             rclpy.try_shutdown()

@@ -1,12 +1,13 @@
-"""How a process serves its nodes: two planes, each on an executor and a thread of its own.
+"""How a process serves its nodes: three planes, each on an executor and a thread of its own.
 
 - The control plane (stop, pause, resume, servo, get_state, the getters and setters, parameters,
   the timers and topics) runs on rclpy's `EventsExecutor`: it keeps no wait set to rebuild on
   every wake (48 % of the GIL under a getter storm with the MultiThreadedExecutor), so a call
   costs about what a bare node's does. Nothing on it plans or waits.
-- The motion plane (the services that plan a move, action goals, cmd_vel/joy) runs on a
-  `SingleThreadedExecutor` (goals are coroutines that await; the EventsExecutor would poll them
-  without pause): planning for ms there never delays the control plane.
+- The motion plane (the services that plan a move, cmd_vel/joy) runs on an `EventsExecutor` of
+  its own: planning for ms there never delays the control plane.
+- The goal plane (the action servers) runs on a `SingleThreadedExecutor`: goals are coroutines
+  that await (`acti_bringup.waiting`), which the EventsExecutor would poll without pause.
 
 Each executor is driven by a `spin_once` loop (the EventsExecutor's `spin()` serves nothing in
 this rclpy and neither honours SIGINT); SIGINT and SIGTERM are handled here, on the main thread.
@@ -60,22 +61,21 @@ class SpinLoop:
 
 
 class Planes:
-    """The control and motion executors of one process and their loops."""
+    """The executors of one process, one per plane, and their loops."""
+
+    KINDS: dict[str, Callable[[], Executor]] = {
+        "control": EventsExecutor, "motion": EventsExecutor, "goals": SingleThreadedExecutor}
 
     def __init__(self) -> None:
-        self.control = EventsExecutor()
-        self.motion = SingleThreadedExecutor()
+        self.executors = {plane: kind() for plane, kind in self.KINDS.items()}
         self._loops: list[SpinLoop] = []
 
-    def add(self, control: Iterable[Node], motion: Iterable[Node]) -> None:
-        for n in control:
-            self.control.add_node(n)
-        for n in motion:
-            self.motion.add_node(n)
+    def add(self, plane: str, nodes: Iterable[Node]) -> None:
+        for n in nodes:
+            self.executors[plane].add_node(n)
 
     def start(self) -> None:
-        self._loops = [SpinLoop(self.control, "ros-control").start(),
-                       SpinLoop(self.motion, "ros-motion").start()]
+        self._loops = [SpinLoop(ex, f"ros-{plane}").start() for plane, ex in self.executors.items()]
 
     def serving(self) -> bool:
         return all(loop.alive for loop in self._loops)
@@ -86,8 +86,8 @@ class Planes:
     def stop(self) -> None:
         for loop in self._loops:
             loop.stop()
-        self.motion.shutdown(timeout_sec=5.0)
-        self.control.shutdown(timeout_sec=5.0)
+        for ex in self.executors.values():
+            ex.shutdown(timeout_sec=5.0)
 
 
 def wait_for_signal(still_serving: Callable[[], bool]) -> None:

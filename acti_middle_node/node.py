@@ -9,7 +9,7 @@ import pinocchio as pin
 from acti_msgs.msg import Alarm, ArmState, ReturnId
 from rclpy.node import Node
 
-from acti_bringup.adapter import MotionPlane, serve_operations
+from acti_bringup.adapter import Plane, serve_operations
 from acti_bringup.parameters import declare_config
 from acti_bringup.simulation import Simulation
 from acti_middle_node.actions import ActionConfig, MotionActions
@@ -36,14 +36,14 @@ class ArmNode(Node):
         super().__init__("acti_middle_node")
         self.simulation = simulation or Simulation(self)
         self.core = ArmCore(self.simulation.executor, declare_config(self, ArmConfig))
-        self.motion = MotionPlane(self)
+        self.motion, self.goals = Plane(self, "motion"), Plane(self, "goals")
         serve_operations(self, self.motion, self.core, OPERATIONS, write_return_id)
         actions = declare_config(self, ActionConfig)
         topics = declare_config(self, TopicConfig)
         if actions.feedback_rate_hz <= 0 or topics.state_rate_hz <= 0:
             raise ValueError("feedback_rate_hz and state_rate_hz must be > 0")
-        self.actions = MotionActions(self.motion, self.core, actions)
-        self.programs = ProgramAction(self.motion, self.core, actions.feedback_rate_hz,
+        self.actions = MotionActions(self.goals, self.core, actions)
+        self.programs = ProgramAction(self.goals, self.core, actions.feedback_rate_hz,
                                       declare_config(self, ProgramDefaults))
         self._state = self.create_publisher(ArmState, "~/state", 10)
         self.create_timer(1.0 / topics.state_rate_hz, self._publish_state)

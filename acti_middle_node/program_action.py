@@ -2,7 +2,7 @@
 progress as feedback; canceling stops the program and the arm.
 
 The program runs on a thread of its own (`acti_motion.programs.run.ProgramRun`), never on an
-executor's thread; the goal's coroutine awaits its end on the motion plane without holding that
+executor's thread; the goal's coroutine awaits its end on the goal plane without holding that
 thread (`acti_bringup.waiting.Watch`) and publishes feedback meanwhile, while the control plane
 serves stop, pause, resume and get_state. One program runs at a time. The robot's
 digital I/O (`RobotIO`) lives as long as the node: outputs keep their values from run to run.
@@ -16,7 +16,7 @@ from typing import Any
 from acti_msgs.action import RunProgram
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 
-from acti_bringup.adapter import MotionPlane
+from acti_bringup.adapter import Plane
 from acti_bringup.conversions import fill
 from acti_bringup.waiting import Watch
 from acti_motion.arm.core import ArmCore
@@ -28,7 +28,7 @@ from strolic.errors import StrolicError
 class ProgramAction:
     """~/run_program of one ArmCore."""
 
-    def __init__(self, plane: MotionPlane, core: ArmCore, feedback_rate_hz: float,
+    def __init__(self, plane: Plane, core: ArmCore, feedback_rate_hz: float,
                  defaults: ProgramDefaults) -> None:
         self.node, self.core, self.defaults = plane.owner, core, defaults
         self.watch = Watch(plane, 1.0 / feedback_rate_hz)

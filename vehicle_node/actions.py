@@ -1,5 +1,5 @@
 """vehicle_node's completion path: ~/wait_motion waits for a motion a move service queued, with
-feedback (progress, queue, pose) and cancel. Goals await on the motion plane without holding its
+feedback (progress, queue, pose) and cancel. Goals await on the goal plane without holding its
 thread; at most `max_wait_goals` run at once, more are rejected (`acti_bringup.waiting`)."""
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from typing import Any
 from acti_msgs.action import VehicleWaitMotion
 from rclpy.action import ActionServer
 
-from acti_bringup.adapter import MotionPlane
+from acti_bringup.adapter import Plane
 from acti_bringup.conversions import fill
 from acti_bringup.waiting import GoalSlots, accept_cancel, device_watch, wait_for_motion
 from acti_motion.vehicle.core import VehicleCore
@@ -22,7 +22,7 @@ class WaitConfig:
 
 
 class WaitMotionServer:
-    def __init__(self, plane: MotionPlane, core: VehicleCore, config: WaitConfig) -> None:
+    def __init__(self, plane: Plane, core: VehicleCore, config: WaitConfig) -> None:
         if config.wait_feedback_rate_hz <= 0:
             raise ValueError("wait_feedback_rate_hz must be > 0")
         self.core = core

@@ -21,7 +21,7 @@ from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from sensor_msgs.msg import Joy
 
-from acti_bringup.adapter import MotionPlane, serve_operations
+from acti_bringup.adapter import Plane, serve_operations
 from acti_bringup.parameters import declare_config
 from acti_bringup.simulation import Simulation
 from acti_motion.vehicle.paths import Pose2D
@@ -62,9 +62,9 @@ class VehicleNode(Node):
         super().__init__("vehicle_node")
         self.simulation = simulation or Simulation(self)
         self.core = VehicleCore(self.simulation.executor, declare_config(self, VehicleConfig))
-        self.motion = MotionPlane(self)
+        self.motion, self.goals = Plane(self, "motion"), Plane(self, "goals")
         serve_operations(self, self.motion, self.core, OPERATIONS, write_success)
-        self.wait_motion = WaitMotionServer(self.motion, self.core, declare_config(self, WaitConfig))
+        self.wait_motion = WaitMotionServer(self.goals, self.core, declare_config(self, WaitConfig))
         self._odom = self.create_publisher(Odometry, "odom", 10)
         self._truth = self.create_publisher(Odometry, "~/ground_truth", 10)
         self._state = self.create_publisher(VehicleStatus, "~/state", 10)
