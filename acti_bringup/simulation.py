@@ -12,7 +12,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
 from acti_bringup.parameters import declare_config
-from acti_bringup.spinning import Planes, wait_for_signal
+from acti_bringup.spinning import Planes, init, wait_for_signal
 from acti_motion.executor import MotionExecutor
 from acti_sim.world import World
 
@@ -87,6 +87,6 @@ class Simulation:
 
 def run_alone(node_class: type, args: list[str] | None = None) -> None:
     """`python -m <node>`: one node with a simulation of its own, until SIGINT/SIGTERM."""
-    rclpy.init(args=sys.argv if args is None else args)
+    init(sys.argv if args is None else args)
     node = node_class()
     node.simulation.spin(node)

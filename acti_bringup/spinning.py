@@ -16,15 +16,30 @@ from __future__ import annotations
 
 import signal
 import threading
-from typing import Any, Callable, Iterable
+from typing import Callable, Iterable
 
 import rclpy
 from rclpy.executors import Executor, SingleThreadedExecutor
+from rclpy.signals import SignalHandlerOptions
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 
 SPIN_TIMEOUT_S = 0.5        # a loop's longest sleep: how soon it notices it should end
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
+_stop_requested = threading.Event()
+
+
+def catch_signals() -> None:
+    """SIGINT/SIGTERM only set a flag that `wait_for_signal` watches: a signal while the nodes
+    are still being built ends the process as cleanly as one while they serve."""
+    for s in SIGNALS:
+        signal.signal(s, lambda _signum, _frame: _stop_requested.set())
+
+
+def init(args: list[str]) -> None:
+    """rclpy.init with this module's signal handling instead of rclpy's."""
+    catch_signals()
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
 
 
 class SpinLoop:
@@ -93,14 +108,9 @@ class Planes:
 def wait_for_signal(still_serving: Callable[[], bool]) -> None:
     """Block the main thread until SIGINT/SIGTERM (or until `still_serving()` says no).
 
-    Installed after the executors exist, so these handlers replace any they or rclpy.init put in.
+    The handlers are installed again: each EventsExecutor puts in its own when created.
     """
-    stop = threading.Event()
-
-    def on_signal(_signum: int, _frame: Any) -> None:
-        stop.set()
-    for s in SIGNALS:
-        signal.signal(s, on_signal)
-    while not stop.wait(SPIN_TIMEOUT_S):
+    catch_signals()
+    while not _stop_requested.wait(SPIN_TIMEOUT_S):
         if not (still_serving() and rclpy.ok()):
             return

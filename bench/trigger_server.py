@@ -12,7 +12,7 @@ from rclpy.executors import MultiThreadedExecutor, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
 from std_srvs.srv import Trigger
 
-from acti_bringup.spinning import SpinLoop, wait_for_signal
+from acti_bringup.spinning import SpinLoop, init, wait_for_signal
 
 EXECUTORS = {"events": EventsExecutor, "single": SingleThreadedExecutor,
              "multi": MultiThreadedExecutor}
@@ -22,7 +22,7 @@ KIND = "events"
 def main() -> None:
     args = rclpy.utilities.remove_ros_args(sys.argv)
     kind = args[1] if len(args) > 1 else KIND
-    rclpy.init(args=sys.argv)
+    init(sys.argv)
     node = rclpy.create_node("bare_trigger")
 
     def answer(_req, resp):
