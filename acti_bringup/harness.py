@@ -2,6 +2,7 @@
 the benchmarks alike."""
 from __future__ import annotations
 
+import ctypes
 import os
 import signal
 import subprocess
@@ -12,6 +13,16 @@ from typing import Any, Callable
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SERVICE_TIMEOUT = 30.0
 CALL_TIMEOUT = 30.0
+ACTION_TIMEOUT = 60.0
+
+
+PR_SET_PDEATHSIG = 1
+
+
+def _end_with_parent() -> None:
+    """In the child: SIGTERM it when the process that started it dies, however it dies (a crash
+    of a test or bench process leaves no node running behind it)."""
+    ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
 class NodeProcess:
@@ -23,7 +34,8 @@ class NodeProcess:
             command += ["-p", p]
         self.log_path = log_path
         self._log = open(log_path, "w")
-        self.proc = subprocess.Popen(command, cwd=ROOT, stdout=self._log, stderr=subprocess.STDOUT)
+        self.proc = subprocess.Popen(command, cwd=ROOT, stdout=self._log, stderr=subprocess.STDOUT,
+                                     preexec_fn=_end_with_parent)
 
     def alive(self) -> bool:
         return self.proc.poll() is None
@@ -51,12 +63,16 @@ class RosClient:
     long-lived executor gets slower with every call (2 ms to 30 ms over 900 calls), which would
     make the benchmarks measure the client."""
 
-    def __init__(self) -> None:
+    def __init__(self, name: str = "acti_test_client", call_timeout: float = CALL_TIMEOUT) -> None:
+        """The first client of a process initialises rclpy (and shuts it down on close)."""
         import rclpy
         from rclpy.executors import SingleThreadedExecutor
         self.rclpy = rclpy
-        rclpy.init()
-        self.node = rclpy.create_node("acti_test_client")
+        self._owns_context = not rclpy.ok()
+        if self._owns_context:
+            rclpy.init()
+        self.node = rclpy.create_node(name)
+        self.call_timeout = call_timeout
         self.executor = SingleThreadedExecutor()
         self.executor.add_node(self.node)
         self._clients: dict[str, Any] = {}
@@ -69,8 +85,8 @@ class RosClient:
         if not client.service_is_ready() and not client.wait_for_service(timeout_sec=SERVICE_TIMEOUT):
             raise TimeoutError(f"service {name} did not appear")
         future = client.call_async(srv_type.Request(**fields))
-        if not self.wait(future, CALL_TIMEOUT):
-            raise TimeoutError(f"{name} did not answer in {CALL_TIMEOUT} s")
+        if not self.wait(future, self.call_timeout):
+            raise TimeoutError(f"{name} did not answer in {self.call_timeout} s")
         return future.result()
 
     def wait(self, future: Any, timeout: float) -> bool:
@@ -91,7 +107,39 @@ class RosClient:
     def close(self) -> None:
         self.executor.shutdown()
         self.node.destroy_node()
-        self.rclpy.try_shutdown()
+        if self._owns_context:
+            self.rclpy.try_shutdown()
+
+
+class Actions:
+    """Goals of one action (its full name) over the test client's executor."""
+
+    def __init__(self, ros: "RosClient", action_type: type, name: str) -> None:
+        from rclpy.action import ActionClient
+        self.ros, self.type = ros, action_type
+        self.client = ActionClient(ros.node, action_type, name)
+        assert self.client.wait_for_server(timeout_sec=30.0)
+
+    def spin(self, future, timeout: float = ACTION_TIMEOUT):
+        assert self.ros.wait(future, timeout), "no answer in time"
+        return future.result()
+
+    def offer(self, feedback=None, **fields):
+        """The goal handle, accepted or not."""
+        return self.spin(self.client.send_goal_async(self.type.Goal(**fields),
+                                                     feedback_callback=feedback))
+
+    def send(self, feedback=None, **fields):
+        handle = self.offer(feedback, **fields)
+        assert handle.accepted
+        return handle
+
+    def result(self, handle):
+        out = self.spin(handle.get_result_async())
+        return out.status, out.result
+
+    def cancel(self, handle) -> None:
+        self.spin(handle.cancel_goal_async())
 
 
 def wait_until(predicate: Callable[[], bool], timeout: float, period: float = 0.05) -> bool:

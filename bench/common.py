@@ -21,7 +21,7 @@ os.environ.setdefault("ROS_DOMAIN_ID", str(101 + os.getpid() % 60))
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 os.environ["FASTDDS_BUILTIN_TRANSPORTS"] = "UDPv4"
 
-from acti_bringup.harness import NodeProcess, RosClient  # noqa: E402
+from acti_bringup.harness import Actions, NodeProcess, RosClient  # noqa: E402
 from bench.trigger_server import KIND as BARE_EXECUTOR  # noqa: E402
 
 BARE = "/bare_trigger/trigger"
@@ -116,5 +116,5 @@ def worst_ratios(samples: dict[str, np.ndarray], baseline: str) -> tuple[float, 
     return (max(p(s, 50) for s in rest) / p(base, 50), max(p(s, 99) for s in rest) / p(base, 99))
 
 
-__all__ = ["RosClient", "running", "bare_call", "interleaved", "against", "row", "table", "p",
+__all__ = ["Actions", "RosClient", "running", "bare_call", "interleaved", "against", "row", "table", "p",
            "worst_ratios", "idle_cpu_percent"]

@@ -5,10 +5,9 @@ import signal
 
 import pytest
 
-from acti_bringup.harness import NodeProcess, RosClient, wait_until  # noqa: F401
+from acti_bringup.harness import Actions, NodeProcess, RosClient, wait_until  # noqa: F401
 
 TEST_RATE = "real_time_factor:=4.0"
-ACTION_TIMEOUT = 60.0
 
 
 @pytest.fixture(scope="session")
@@ -32,33 +31,3 @@ def node_fixture(module: str, *params: str):
         assert "Traceback" not in node.log(), f"{module} logged an exception:\n{node.log()}"
     return fixture
 
-
-class Actions:
-    """Goals of one action (its full name) over the test client's executor."""
-
-    def __init__(self, ros: RosClient, action_type: type, name: str) -> None:
-        from rclpy.action import ActionClient
-        self.ros, self.type = ros, action_type
-        self.client = ActionClient(ros.node, action_type, name)
-        assert self.client.wait_for_server(timeout_sec=30.0)
-
-    def spin(self, future, timeout: float = ACTION_TIMEOUT):
-        assert self.ros.wait(future, timeout), "no answer in time"
-        return future.result()
-
-    def offer(self, feedback=None, **fields):
-        """The goal handle, accepted or not."""
-        return self.spin(self.client.send_goal_async(self.type.Goal(**fields),
-                                                     feedback_callback=feedback))
-
-    def send(self, feedback=None, **fields):
-        handle = self.offer(feedback, **fields)
-        assert handle.accepted
-        return handle
-
-    def result(self, handle):
-        out = self.spin(handle.get_result_async())
-        return out.status, out.result
-
-    def cancel(self, handle) -> None:
-        self.spin(handle.cancel_goal_async())
