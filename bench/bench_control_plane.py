@@ -13,6 +13,7 @@ time + 2 control periods, /clock never silent for more than 2 control periods.
 """
 from __future__ import annotations
 
+import math
 import os
 import subprocess
 import sys
@@ -36,7 +37,7 @@ MAX_GOALS = 4                       # max_action_goals and max_wait_goals of the
 QUEUE = 8                           # queue_size of both devices
 STORM_CLIENTS = 8
 ARM_DECEL_S = 0.3                   # accel_time_joint
-BASE_DECEL_S = 45.0 / 90.0          # default rotation velocity / default rotation acceleration
+BASE_DECEL_S = 300.0 / 500.0        # default velocity / default acceleration (translation)
 
 
 class Background:
@@ -88,6 +89,7 @@ class Device:
     start: Callable[[RosClient, int], int | None]  # a motion that runs seconds: its id (or None)
     stop_srv: type
     fill: Callable[[RosClient, int], Any]          # one more queued move
+    at_rest: Callable[[RosClient], bool]
 
 
 def arm_start(ros: RosClient, trial: int) -> int | None:
@@ -96,18 +98,29 @@ def arm_start(ros: RosClient, trial: int) -> int | None:
     return r.motion_id if r.return_id.id == 0 else None
 
 
+def ahead(ros: RosClient, forward: float, left: float = 0.0) -> VehiclePoint:
+    """A point `forward` mm ahead of the base and `left` mm to its left."""
+    pos = ros.call(srv.VehicleGetPosition, BASE + "get_position").pos
+    c, s = math.cos(math.radians(pos.theta)), math.sin(math.radians(pos.theta))
+    return VehiclePoint(x=pos.x + forward * c - left * s, y=pos.y + forward * s + left * c)
+
+
 def base_start(ros: RosClient, trial: int) -> int | None:
-    r = ros.call(srv.VehicleMoveTurn, BASE + "move_turn", theta=180.0 if trial % 2 else -180.0)
+    """A cruise 1.5 m ahead (the base takes a move only when Ready; cruise points add up)."""
+    r = ros.call(srv.VehicleMoveCruiseAbs, BASE + "move_cruise_abs",
+                 cruise_point=ahead(ros, 1500.0))
     return r.motion_id if r.success else None
 
 
 DEVICES = [
     Device("arm", ARM, WaitMotion, ARM_DECEL_S, arm_start, srv.Stop,
            lambda ros, i: ros.call(srv.MovePTPJointRel, ARM + "move_ptp_joint_rel",
-                                   joint_points=[1.0 if i % 2 else -1.0] * 7)),
+                                   joint_points=[1.0 if i % 2 else -1.0] * 7),
+           lambda ros: not ros.call(srv.GetState, ARM + "get_state").state & 0x02),
     Device("base", BASE, VehicleWaitMotion, BASE_DECEL_S, base_start, srv.VehicleStop,
-           lambda ros, i: ros.call(srv.VehicleMoveTurn, BASE + "move_turn",
-                                   theta=1.0 if i % 2 else -1.0)),
+           lambda ros, i: ros.call(srv.VehicleMoveCruiseAbs, BASE + "move_cruise_abs",
+                                   cruise_point=ahead(ros, 1600.0 + 100.0 * i)),
+           lambda ros: ros.call(srv.VehicleGetState, BASE + "get_state").state == 0x010),
 ]
 
 
@@ -120,16 +133,16 @@ def prepare(ros: RosClient) -> None:
     ros.call(srv.VehicleSetServo, BASE + "set_servo", on_off=True)
 
 
-def long_plan(bg: Background, device: Device, trial: int) -> Any:
-    """A request that plans for long: an 800 mm line for the arm, a cruise point 3 m away for
-    the base (each plans from the end of the queue)."""
+def long_plan(ros: RosClient, bg: Background, device: Device, trial: int) -> Any:
+    """A request that plans for long: an 800 mm line for the arm, one more cruise point 3 m away
+    for the base (each plans from the end of the queue, sent by the background client)."""
     if device.name == "arm":
         m = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 800.0 if trial % 2 else -800.0,
              0.0, 0.0, 1.0, 0.0]
         return bg.send(srv.MoveLinearCartesianRel, ARM + "move_linear_cartesian_rel",
                        car_point=CarPosWithElbow(car_pos=m))
     return bg.send(srv.VehicleMoveCruiseAbs, BASE + "move_cruise_abs",
-                   cruise_point=VehiclePoint(x=3000.0, y=1000.0 if trial % 2 else -1000.0))
+                   cruise_point=ahead(ros, 3000.0, 1000.0 if trial % 2 else -1000.0))
 
 
 @dataclass
@@ -151,6 +164,7 @@ def started(ros: RosClient, device: Device, trial: int) -> int:
         if motion_id is not None:
             return motion_id
         ros.call(device.stop_srv, device.path + "stop")
+        ros.spin_until(lambda: device.at_rest(ros), 10.0)
     raise RuntimeError(f"{device.name}: no motion accepted in 100 tries")
 
 
@@ -239,7 +253,7 @@ def storm_client(seconds: float) -> None:
 def scenarios(ros: RosClient, bg: Background) -> dict[str, tuple[Load, Callable[[], Any]]]:
     """name → (per-trial load, context around the whole case)."""
     def planning(device: Device, trial: int, _motion_id: int) -> Any:
-        future = long_plan(bg, device, trial)
+        future = long_plan(ros, bg, device, trial)
         time.sleep(0.003)                   # the plan is under way when stop is called
         return future
 
