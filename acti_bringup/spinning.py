@@ -36,6 +36,11 @@ def catch_signals() -> None:
         signal.signal(s, lambda _signum, _frame: _stop_requested.set())
 
 
+def stop_requested() -> bool:
+    """SIGINT or SIGTERM came (after `catch_signals`)."""
+    return _stop_requested.is_set()
+
+
 def init(args: list[str]) -> None:
     """rclpy.init with this module's signal handling instead of rclpy's."""
     catch_signals()

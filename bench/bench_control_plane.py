@@ -26,10 +26,13 @@ from typing import Any, Callable, Iterator
 import numpy as np
 from common import Actions, RosClient, bare_call, p, running
 
+import rclpy
 from acti_msgs import srv
 from acti_msgs.action import VehicleWaitMotion, WaitMotion
 from acti_msgs.msg import CarPosWithElbow, VehiclePoint
 from rosgraph_msgs.msg import Clock
+
+from acti_bringup.spinning import init, stop_requested
 
 ARM, BASE = "/acti_middle_node/", "/vehicle_node/"
 TRIALS = 20
@@ -228,7 +231,9 @@ def storm(seconds: float) -> Iterator[None]:
 
 
 def storm_client(seconds: float) -> None:
-    """One storm client: getters of both nodes and small moves, as fast as it can."""
+    """One storm client: getters of both nodes and small moves, as fast as it can, until
+    `seconds` pass or SIGTERM comes."""
+    init(sys.argv)
     ros = RosClient(f"bench_storm_{os.getpid()}", call_timeout=5.0)
     calls = [lambda: ros.call(srv.GetState, ARM + "get_state"),
              lambda: ros.call(srv.GetFeedbackPosJoint, ARM + "get_feedback_pos_joint"),
@@ -241,13 +246,14 @@ def storm_client(seconds: float) -> None:
              lambda: ros.call(srv.VehicleMoveTurn, BASE + "move_turn", theta=-0.5)]
     end = time.monotonic() + seconds
     i = 0
-    while time.monotonic() < end:
+    while time.monotonic() < end and not stop_requested():
         try:
             calls[i % len(calls)]()
         except TimeoutError:                # a storm goes on (a lost call is DDS's, not ours)
             pass
         i += 1
     ros.close()
+    rclpy.try_shutdown()
 
 
 def scenarios(ros: RosClient, bg: Background) -> dict[str, tuple[Load, Callable[[], Any]]]:

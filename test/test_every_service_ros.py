@@ -11,7 +11,6 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 import pytest
-from acti_msgs import srv
 from acti_msgs.msg import CarPosWithElbow, CartesianSpeed, LimitValue
 from acti_msgs.msg import VehiclePoint, VehiclePosition, VehicleVelocity
 
