@@ -61,6 +61,11 @@ def interleaved(calls: Calls, n: int, warmup: int = 30) -> dict[str, np.ndarray]
     return {name: np.array(sample) for name, sample in out.items()}
 
 
+def latencies(fn: Callable[[], object], n: int, warmup: int = 30) -> np.ndarray:
+    """Wall seconds of n calls of fn alone, after a warm-up (no baseline to interleave)."""
+    return interleaved([("calls", fn)], n, warmup)["calls"]
+
+
 def against(baseline: tuple[str, Callable[[], object]], measured: Calls) -> Calls:
     """The baseline call before each measured one: A B A C A D …"""
     return [c for m in measured for c in (baseline, m)]
@@ -116,5 +121,6 @@ def worst_ratios(samples: dict[str, np.ndarray], baseline: str) -> tuple[float, 
     return (max(p(s, 50) for s in rest) / p(base, 50), max(p(s, 99) for s in rest) / p(base, 99))
 
 
-__all__ = ["Actions", "RosClient", "running", "bare_call", "interleaved", "against", "row", "table", "p",
+__all__ = ["Actions", "RosClient", "running", "bare_call", "interleaved", "latencies", "against",
+           "row", "table", "p",
            "worst_ratios", "idle_cpu_percent"]
