@@ -6,14 +6,13 @@ from __future__ import annotations
 
 import sys
 
-import rclpy
-
+from acti_bringup.spinning import init
 from acti_middle_node.node import ArmNode
 from vehicle_node.node import VehicleNode
 
 
 def main(args: list[str] | None = None) -> None:
-    rclpy.init(args=sys.argv if args is None else args)
+    init(sys.argv if args is None else args)
     arm = ArmNode()
     vehicle = VehicleNode(simulation=arm.simulation)
     arm.simulation.spin(arm, vehicle)

@@ -1,15 +1,24 @@
-"""Table-driven service registration: one row per IDL operation, one core method per row."""
+"""Table-driven service registration: one row per IDL operation, one core method per row.
+
+Operations that plan a motion are served by the device's motion plane (a `Plane` node), every
+other one by the device node itself on the control plane (see `acti_bringup.spinning`): a move
+planning for milliseconds never delays stop, pause or get_state. Clients see one node's services
+either way (`/<ns>/<node>/<operation>`).
+"""
 from __future__ import annotations
 
 import traceback
 from dataclasses import dataclass
 from typing import Any, Callable
 
-from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
-from acti_bringup.conversions import fill, to_core
+from acti_bringup.conversions import fill, request_reader
 from acti_motion.replies import Reply, ReturnCode
+
+# Operations that queue or re-plan motion: move_*, the gripper's and home moves, the base's
+# set_velocity (it re-times a running cruise).
+PLANNING = ("move_", "go_home", "open_gripper", "close_gripper", "set_velocity")
 
 
 @dataclass(frozen=True)
@@ -18,20 +27,39 @@ class Operation:
     name: str
     srv_type: type
 
+    @property
+    def plans(self) -> bool:
+        return self.name.startswith(PLANNING)
+
+
+class Plane(Node):
+    """A node that holds part of a device node's entities so that another executor serves them
+    (`acti_bringup.spinning`): "motion" (planning services, command topics) or "goals" (action
+    servers). An implementation detail (hidden name, no parameters of its own): its services
+    and actions are named under the device node."""
+
+    def __init__(self, owner: Node, plane: str) -> None:
+        super().__init__(f"_{owner.get_name()}_{plane}", namespace=owner.get_namespace(),
+                         start_parameter_services=False)
+        self.owner, self.plane = owner, plane
+
+    def name(self, entity: str) -> str:
+        """`~/entity` of the device node, as an absolute name."""
+        return f"{self.owner.get_fully_qualified_name()}/{entity.removeprefix('~/')}"
+
 
 StatusWriter = Callable[[Any, Reply], None]
 
 
-def serve_operations(node: Node, core: Any, operations: tuple[Operation, ...],
-                     write_status: StatusWriter) -> list:
-    """Create `~/<name>` for every row, calling `core.<name>(**request fields)`."""
-    group = ReentrantCallbackGroup()
+def serve_operations(node: Node, motion: Plane, core: Any,
+                     operations: tuple[Operation, ...], write_status: StatusWriter) -> list:
+    """Create `~/<name>` for every row, calling `core.<name>(**request fields)`: on `motion`
+    for the rows that plan, on `node` for the others."""
     services = []
     for op in operations:
-        method = getattr(core, op.name)
-        services.append(node.create_service(op.srv_type, f"~/{op.name}",
-                                            _handler(node, op, method, write_status),
-                                            callback_group=group))
+        handler = _handler(node, op, getattr(core, op.name), write_status)
+        host, name = (motion, motion.name(op.name)) if op.plans else (node, f"~/{op.name}")
+        services.append(host.create_service(op.srv_type, name, handler))
     node.get_logger().info(f"{len(services)} services under {node.get_fully_qualified_name()}/: "
                            + ", ".join(op.name for op in operations))
     return services
@@ -39,10 +67,11 @@ def serve_operations(node: Node, core: Any, operations: tuple[Operation, ...],
 
 def _handler(node: Node, op: Operation, method: Callable[..., Reply],
              write_status: StatusWriter) -> Callable[[Any, Any], Any]:
+    read = request_reader(op.srv_type.Request)
+
     def handle(request: Any, response: Any) -> Any:
-        kwargs = {f: to_core(getattr(request, f)) for f in request.get_fields_and_field_types()}
         try:
-            reply = method(**kwargs)
+            reply = method(**read(request))
             write_status(response, reply)
             fill(response, reply.values)
         except Exception as e:  # a bug must not take the node down; the caller is told

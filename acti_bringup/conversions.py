@@ -6,8 +6,9 @@ A nested message is read as the tuple of its fields and written from a tuple (fi
 """
 from __future__ import annotations
 
+import functools
 import importlib
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 from rosidl_parser.definition import AbstractNestedType, NamespacedType
@@ -26,6 +27,30 @@ def to_core(value: Any) -> Any:
     return value
 
 
+def _reader(slot: Any) -> Callable[[Any], Any]:
+    """`to_core` specialised to one field's type, decided once instead of on every value."""
+    if isinstance(slot, NamespacedType):
+        return to_core
+    if isinstance(slot, AbstractNestedType):
+        if isinstance(slot.value_type, NamespacedType):
+            return to_core
+        return lambda v: v.tolist() if hasattr(v, "tolist") else list(v)
+    return lambda v: v
+
+
+def request_reader(request_type: type) -> Callable[[Any], dict[str, Any]]:
+    """The core keyword arguments of a request of `request_type`: the field list and each
+    field's conversion are looked up here, once per operation, not on every call."""
+    fields = tuple(zip(request_type.get_fields_and_field_types(), map(_reader,
+                                                                       request_type.SLOT_TYPES)))
+    return lambda request: {name: read(getattr(request, name)) for name, read in fields}
+
+
+@functools.lru_cache(maxsize=None)
+def _slots(cls: type) -> dict[str, Any]:
+    return dict(zip(cls.get_fields_and_field_types(), cls.SLOT_TYPES))
+
+
 def _message_class(t: NamespacedType) -> type:
     return getattr(importlib.import_module(".".join(t.namespaces)), t.name)
 
@@ -34,14 +59,11 @@ def _build(cls: type, value: Any) -> Any:
     """A message of class `cls` from a tuple (in field order), a dict, or a message already."""
     if isinstance(value, cls):
         return value
-    names = list(cls.get_fields_and_field_types())
-    if isinstance(value, dict):
-        items = value.items()
-    else:
-        items = zip(names, value)
+    slots = _slots(cls)
+    items = value.items() if isinstance(value, dict) else zip(slots, value)
     msg = cls()
-    for (name, v), slot in zip(items, cls.SLOT_TYPES):
-        setattr(msg, name, _convert(slot, v))
+    for name, v in items:
+        setattr(msg, name, _convert(slots[name], v))
     return msg
 
 
@@ -63,7 +85,6 @@ def _scalar(v: Any) -> Any:
 
 def fill(msg: Any, values: dict[str, Any]) -> None:
     """Write core out-values into the same-named fields of a message (KeyError if absent)."""
-    fields = list(msg.get_fields_and_field_types())
+    slots = _slots(type(msg))
     for name, value in values.items():
-        slot = msg.SLOT_TYPES[fields.index(name)]
-        setattr(msg, name, _convert(slot, value))
+        setattr(msg, name, _convert(slots[name], value))

@@ -2,6 +2,7 @@
 the benchmarks alike."""
 from __future__ import annotations
 
+import ctypes
 import os
 import signal
 import subprocess
@@ -12,18 +13,29 @@ from typing import Any, Callable
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SERVICE_TIMEOUT = 30.0
 CALL_TIMEOUT = 30.0
+ACTION_TIMEOUT = 60.0
+
+
+PR_SET_PDEATHSIG = 1
+
+
+def _end_with_parent() -> None:
+    """In the child: SIGTERM it when the process that started it dies, however it dies (a crash
+    of a test or bench process leaves no node running behind it)."""
+    ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
 class NodeProcess:
-    """`python -m <module>` with --ros-args; stopped by PID (SIGINT, then SIGKILL)."""
+    """`python -m <module> [args] --ros-args -p <params>`; stopped by PID (SIGINT, then SIGKILL)."""
 
-    def __init__(self, module: str, log_path: str, *params: str) -> None:
-        args = [sys.executable, "-m", module, "--ros-args"]
+    def __init__(self, module: str, log_path: str, *params: str, args: tuple[str, ...] = ()) -> None:
+        command = [sys.executable, "-m", module, *args, "--ros-args"]
         for p in params:
-            args += ["-p", p]
+            command += ["-p", p]
         self.log_path = log_path
         self._log = open(log_path, "w")
-        self.proc = subprocess.Popen(args, cwd=ROOT, stdout=self._log, stderr=subprocess.STDOUT)
+        self.proc = subprocess.Popen(command, cwd=ROOT, stdout=self._log, stderr=subprocess.STDOUT,
+                                     preexec_fn=_end_with_parent)
 
     def alive(self) -> bool:
         return self.proc.poll() is None
@@ -45,14 +57,22 @@ class NodeProcess:
 
 
 class RosClient:
-    """One rclpy node in the test process that calls services and waits for conditions."""
+    """One rclpy node in the test process that calls services and waits for conditions.
 
-    def __init__(self) -> None:
+    It waits by `spin_once` in a loop of its own: rclpy's `spin_until_future_complete` on a
+    long-lived executor gets slower with every call (2 ms to 30 ms over 900 calls), which would
+    make the benchmarks measure the client."""
+
+    def __init__(self, name: str = "acti_test_client", call_timeout: float = CALL_TIMEOUT) -> None:
+        """The first client of a process initialises rclpy (and shuts it down on close)."""
         import rclpy
         from rclpy.executors import SingleThreadedExecutor
         self.rclpy = rclpy
-        rclpy.init()
-        self.node = rclpy.create_node("acti_test_client")
+        self._owns_context = not rclpy.ok()
+        if self._owns_context:
+            rclpy.init()
+        self.node = rclpy.create_node(name)
+        self.call_timeout = call_timeout
         self.executor = SingleThreadedExecutor()
         self.executor.add_node(self.node)
         self._clients: dict[str, Any] = {}
@@ -65,24 +85,61 @@ class RosClient:
         if not client.service_is_ready() and not client.wait_for_service(timeout_sec=SERVICE_TIMEOUT):
             raise TimeoutError(f"service {name} did not appear")
         future = client.call_async(srv_type.Request(**fields))
-        self.executor.spin_until_future_complete(future, timeout_sec=CALL_TIMEOUT)
-        if not future.done():
-            raise TimeoutError(f"{name} did not answer in {CALL_TIMEOUT} s")
+        if not self.wait(future, self.call_timeout):
+            raise TimeoutError(f"{name} did not answer in {self.call_timeout} s")
         return future.result()
 
-    def spin_until(self, predicate: Callable[[], bool], timeout: float) -> bool:
+    def wait(self, future: Any, timeout: float) -> bool:
+        """Serve this client until `future` is done; False after `timeout` seconds."""
+        return self.spin_until(future.done, timeout, period=min(timeout, 1.0))
+
+    def spin_until(self, predicate: Callable[[], bool], timeout: float,
+                   period: float = 0.02) -> bool:
         """Serve this client's subscriptions and callbacks until predicate() holds."""
         deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            if predicate():
-                return True
-            self.executor.spin_once(timeout_sec=0.02)
-        return predicate()
+        while not predicate():
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return False
+            self.executor.spin_once(timeout_sec=min(period, left))
+        return True
 
     def close(self) -> None:
         self.executor.shutdown()
         self.node.destroy_node()
-        self.rclpy.try_shutdown()
+        if self._owns_context:
+            self.rclpy.try_shutdown()
+
+
+class Actions:
+    """Goals of one action (its full name) over the test client's executor."""
+
+    def __init__(self, ros: "RosClient", action_type: type, name: str) -> None:
+        from rclpy.action import ActionClient
+        self.ros, self.type = ros, action_type
+        self.client = ActionClient(ros.node, action_type, name)
+        assert self.client.wait_for_server(timeout_sec=30.0)
+
+    def spin(self, future, timeout: float = ACTION_TIMEOUT):
+        assert self.ros.wait(future, timeout), "no answer in time"
+        return future.result()
+
+    def offer(self, feedback=None, **fields):
+        """The goal handle, accepted or not."""
+        return self.spin(self.client.send_goal_async(self.type.Goal(**fields),
+                                                     feedback_callback=feedback))
+
+    def send(self, feedback=None, **fields):
+        handle = self.offer(feedback, **fields)
+        assert handle.accepted
+        return handle
+
+    def result(self, handle):
+        out = self.spin(handle.get_result_async())
+        return out.status, out.result
+
+    def cancel(self, handle) -> None:
+        self.spin(handle.cancel_goal_async())
 
 
 def wait_until(predicate: Callable[[], bool], timeout: float, period: float = 0.05) -> bool:

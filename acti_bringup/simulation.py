@@ -8,7 +8,6 @@ from dataclasses import dataclass
 
 import rclpy
 from builtin_interfaces.msg import Time
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
@@ -16,6 +15,7 @@ from sensor_msgs.msg import JointState
 from acti_bringup.camera import SimCamera
 from acti_bringup.parameters import declare_config
 from acti_bringup.robot_graph import RobotGraph
+from acti_bringup.spinning import Planes, init, wait_for_signal
 from acti_motion.executor import MotionExecutor
 from acti_sim.world import World
 
@@ -67,26 +67,31 @@ class Simulation:
         self._joints.publish(msg)
 
     def spin(self, *nodes: Node) -> None:
-        """Run the simulation and serve the nodes until SIGINT/SIGTERM, then clean up."""
-        executor = MultiThreadedExecutor(num_threads=6)
-        for n in nodes:
-            executor.add_node(n)
+        """Run the simulation and serve the nodes until SIGINT/SIGTERM, then clean up: each node
+        on the control plane, its `motion` and `goals` plane nodes on theirs
+        (`acti_bringup.spinning`)."""
+        planes = Planes()
+        planes.add("control", nodes)
+        helpers = [getattr(n, plane) for plane in ("motion", "goals") for n in nodes]
+        for helper in helpers:
+            planes.add(helper.plane, [helper])
         self.executor.start()
+        planes.start()
         try:
-            executor.spin()
-        except (KeyboardInterrupt, ExternalShutdownException):
-            pass
+            wait_for_signal(planes.serving)
         finally:
             self.executor.shutdown()
-            executor.shutdown()
-            for n in nodes:
+            planes.stop()
+            for n in (*helpers, *nodes):
                 n.destroy_node()
             self.world.close()
             rclpy.try_shutdown()
+        for error in planes.errors():
+            raise error
 
 
 def run_alone(node_class: type, args: list[str] | None = None) -> None:
     """`python -m <node>`: one node with a simulation of its own, until SIGINT/SIGTERM."""
-    rclpy.init(args=sys.argv if args is None else args)
+    init(sys.argv if args is None else args)
     node = node_class()
     node.simulation.spin(node)

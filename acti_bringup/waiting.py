@@ -1,20 +1,27 @@
-"""Waiting for a queued motion, shared by both nodes' action servers.
+"""Waiting in action goals without holding an executor thread, shared by both nodes' servers.
 
-A waiting goal blocks an executor thread (an rclpy coroutine that awaits would spin the
-executor), so `GoalSlots` bounds how many run at once. `wait_for_motion` is the ~/wait_motion
-loop of either device; each node writes the outcome in its own reply style.
+A goal's execute callback is a coroutine on the motion plane's executor. It awaits a `Watch`:
+the watch settles the wait when its condition holds, checked whenever something pokes it (a
+device retiring a motion, a program ending, a cancel request: any thread) and on a periodic
+tick that also publishes feedback. Any number of goals wait on one thread, so the bound
+(`GoalSlots`) only limits what the process keeps track of; a goal beyond it is rejected.
+`wait_for_motion` is the ~/wait_motion of either device; each node writes its own reply style.
 """
 from __future__ import annotations
 
+import math
 import threading
 import time
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Awaitable, Callable, Generic, TypeVar
 
-from rclpy.action import GoalResponse
+from rclpy.action import CancelResponse, GoalResponse
 from rclpy.node import Node
+from rclpy.task import Future
 
 from acti_motion.executor import Device
+
+T = TypeVar("T")
 
 
 class GoalSlots:
@@ -32,14 +39,99 @@ class GoalSlots:
         self._node.get_logger().warning(f"rejected an action goal: {self._parameter} running")
         return GoalResponse.REJECT
 
-    def holding(self, execute: Callable[[Any], Any]) -> Callable[[Any], Any]:
+    def holding(self, execute: Callable[[Any], Awaitable[Any]]) -> Callable[[Any], Awaitable[Any]]:
         """`execute` that gives its slot back however it ends."""
-        def run(goal_handle: Any) -> Any:
+        async def run(goal_handle: Any) -> Any:
             try:
-                return execute(goal_handle)
+                return await execute(goal_handle)
             finally:
                 self._slots.release()
         return run
+
+
+@dataclass
+class _Wait(Generic[T]):
+    outcome: Callable[[], T | None]
+    feedback: Callable[[], None]
+    future: Future
+
+
+class Watch:
+    """Settles awaited conditions on the thread of the executor that serves `node`."""
+
+    def __init__(self, node: Node, period: float) -> None:
+        self._waits: list[_Wait] = []
+        self._guard = node.create_guard_condition(self._settle)
+        self._timer = node.create_timer(period, self._tick)
+        self._timer.cancel()                     # ticks only while something waits
+        self._closing = node.context.ok
+
+    def poke(self) -> None:
+        """Re-check the conditions soon (any thread; cheap and non-blocking)."""
+        try:
+            self._guard.trigger()
+        except Exception:
+            if self._closing():                 # gone with the node at shutdown: nothing waits
+                raise
+
+    async def until(self, outcome: Callable[[], T | None], feedback: Callable[[], None]) -> T:
+        """Wait until `outcome()` is not None (checked on pokes and ticks), calling `feedback()`
+        every tick meanwhile; its value."""
+        now = outcome()
+        if now is not None:
+            return now
+        wait = _Wait(outcome, feedback, Future())
+        self._waits.append(wait)
+        if self._timer.is_canceled():
+            self._timer.reset()
+        return await wait.future
+
+    def _settle(self) -> list[_Wait]:
+        pending = []
+        for wait in self._waits:
+            now = wait.outcome()
+            if now is None:
+                pending.append(wait)
+            else:
+                wait.future.set_result(now)
+        self._waits = pending
+        if not pending:
+            self._timer.cancel()
+        return pending
+
+    def _tick(self) -> None:
+        for wait in self._settle():
+            wait.feedback()
+
+
+def accept_cancel(watch: Watch) -> Callable[[Any], CancelResponse]:
+    """A cancel callback that lets the waiting goal see the request at once."""
+    def cancel(_goal: Any) -> CancelResponse:
+        watch.poke()
+        return CancelResponse.ACCEPT
+    return cancel
+
+
+def is_over(device: Device, motion_id: int) -> bool:
+    """Motion `motion_id` finished or was discarded. `retired_id` alone is not enough: a stop
+    retires the queue behind the current motion at once while the current one still
+    decelerates."""
+    current = device.current
+    return device.retired_id >= motion_id and (current is None or current.id != motion_id)
+
+
+def device_watch(node: Node, device: Device, period: float) -> Watch:
+    """A watch poked whenever `device` retires a motion."""
+    watch = Watch(node, period)
+    device.on_retire(watch.poke)
+    return watch
+
+
+def timeout_error(timeout: float) -> str | None:
+    """Why a goal's `timeout` (s, 0: none) is refused, or None."""
+    if not math.isfinite(timeout) or timeout < 0:
+        return f"timeout is {timeout:g} s: it must be a finite number of seconds >= 0 (0: no limit)"
+    return None
 
 
 @dataclass(frozen=True)
@@ -63,27 +155,29 @@ class WaitOutcome:
 Feedback = Callable[[int, str, float, int], None]
 
 
-def wait_for_motion(goal_handle: Any, device: Device, period: float, discarded_by: str,
-                    feedback: Feedback) -> WaitOutcome:
+async def wait_for_motion(goal_handle: Any, device: Device, watch: Watch, discarded_by: str,
+                          feedback: Feedback) -> WaitOutcome:
     """Wait for goal.motion_id (0: everything queued now) with goal.timeout (0: no limit),
-    calling feedback(current id, label, progress, queue length) every `period` seconds."""
+    calling feedback(current id, label, progress, queue length) every tick of `watch`."""
     goal = goal_handle.request
     target = goal.motion_id or device.last_id
-    if goal.timeout < 0:
-        return WaitOutcome(target, "abort", bad_goal=True,
-                           message=f"timeout is {goal.timeout:g} s: it must be >= 0")
+    refused = timeout_error(goal.timeout)
+    if refused:
+        return WaitOutcome(target, "abort", bad_goal=True, message=refused)
     if goal.motion_id > device.last_id:
         return WaitOutcome(target, "abort", bad_goal=True,
                            message=f"motion {goal.motion_id} was never queued "
                                    f"(the last is {device.last_id})")
-    deadline = time.monotonic() + goal.timeout if goal.timeout > 0 else None
-    while not device.wait(target, period):
+    deadline = time.monotonic() + goal.timeout if goal.timeout > 0 else math.inf
+
+    def outcome() -> WaitOutcome | None:
+        if is_over(device, target):
+            completed = not device.was_discarded(target)
+            return WaitOutcome(target, "succeed", completed,
+                               message="" if completed else f"discarded by {discarded_by}")
         if goal_handle.is_cancel_requested:
             return WaitOutcome(target, "canceled", message="canceled: the motion goes on")
-        if deadline is not None and time.monotonic() > deadline:
-            return WaitOutcome(target, "abort",
-                               message=f"timed out after {goal.timeout:g} s")
-        feedback(*device.status())
-    completed = not device.was_discarded(target)
-    return WaitOutcome(target, "succeed", completed,
-                       message="" if completed else f"discarded by {discarded_by}")
+        if time.monotonic() > deadline:
+            return WaitOutcome(target, "abort", message=f"timed out after {goal.timeout:g} s")
+        return None
+    return await watch.until(outcome, lambda: feedback(*device.status()))

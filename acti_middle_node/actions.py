@@ -1,8 +1,8 @@
 """The arm's completion paths: ~/wait_motion (wait for any queued motion) and ~/move (one move,
 answered when it is over). Both report progress as feedback and can be canceled.
 
-Waiting blocks an executor thread, so the goals of both running at once are bounded
-(`max_action_goals`, see `acti_bringup.waiting`); more are rejected.
+Goals await on the goal plane without holding its thread (`acti_bringup.waiting`); the goals of
+both running at once are bounded (`max_action_goals`) and more are rejected.
 """
 from __future__ import annotations
 
@@ -11,11 +11,12 @@ from typing import Any
 
 from acti_msgs.action import Move, WaitMotion
 from acti_msgs.msg import ReturnId
-from rclpy.action import ActionServer, CancelResponse
-from rclpy.node import Node
+from rclpy.action import ActionServer
 
+from acti_bringup.adapter import Plane
 from acti_bringup.conversions import fill, to_core
-from acti_bringup.waiting import GoalSlots, wait_for_motion
+from acti_bringup.waiting import (GoalSlots, accept_cancel, device_watch, is_over,
+                                   wait_for_motion)
 from acti_motion.arm.core import ArmCore
 from acti_motion.replies import Reply, ReturnCode
 
@@ -39,7 +40,7 @@ MOVE_KINDS: dict[str, tuple[tuple[str, str], ...]] = {
 @dataclass
 class ActionConfig:
     feedback_rate_hz: float = 10.0   # feedback of ~/wait_motion and ~/move [Hz]
-    max_action_goals: int = 4        # goals of both actions running at once; more are rejected
+    max_action_goals: int = 16       # goals of both actions running at once; more are rejected
 
 
 def return_id(reply: Reply) -> ReturnId:
@@ -49,27 +50,26 @@ def return_id(reply: Reply) -> ReturnId:
 class MotionActions:
     """~/wait_motion and ~/move of one ArmCore."""
 
-    def __init__(self, node: Node, core: ArmCore, group: Any, config: ActionConfig) -> None:
-        self.node, self.core, self.config = node, core, config
-        self.period = 1.0 / config.feedback_rate_hz
-        slots = GoalSlots(node, config.max_action_goals, "max_action_goals")
-        accept_cancel = (lambda _goal: CancelResponse.ACCEPT)
+    def __init__(self, plane: Plane, core: ArmCore, config: ActionConfig) -> None:
+        self.core, self.config = core, config
+        self.watch = device_watch(plane, core.device, 1.0 / config.feedback_rate_hz)
+        slots = GoalSlots(plane.owner, config.max_action_goals, "max_action_goals")
+        cancel = accept_cancel(self.watch)
         self.servers = [
-            ActionServer(node, WaitMotion, "~/wait_motion", slots.holding(self._wait),
-                         callback_group=group, goal_callback=slots.admit,
-                         cancel_callback=accept_cancel),
-            ActionServer(node, Move, "~/move", slots.holding(self._move), callback_group=group,
-                         goal_callback=slots.admit, cancel_callback=accept_cancel),
+            ActionServer(plane, WaitMotion, plane.name("wait_motion"), slots.holding(self._wait),
+                         goal_callback=slots.admit, cancel_callback=cancel),
+            ActionServer(plane, Move, plane.name("move"), slots.holding(self._move),
+                         goal_callback=slots.admit, cancel_callback=cancel),
         ]
 
     # --- ~/wait_motion ----------------------------------------------------------------------------
-    def _wait(self, goal_handle: Any) -> WaitMotion.Result:
+    async def _wait(self, goal_handle: Any) -> WaitMotion.Result:
         def feedback(motion_id: int, label: str, progress: float, queued: int) -> None:
             goal_handle.publish_feedback(WaitMotion.Feedback(
                 current_motion_id=motion_id, current_label=label, progress=progress,
                 queue_length=queued))
-        out = wait_for_motion(goal_handle, self.core.device, self.period,
-                              "stop, servo off or an alarm", feedback)
+        out = await wait_for_motion(goal_handle, self.core.device, self.watch,
+                                    "stop, servo off or an alarm", feedback)
         code = (ReturnCode.VALUE_ERR if out.bad_goal else
                 ReturnCode.NG if out.aborted else ReturnCode.OK)
         result = WaitMotion.Result(motion_id=out.motion_id, completed=out.completed,
@@ -78,7 +78,7 @@ class MotionActions:
         return result
 
     # --- ~/move -------------------------------------------------------------------------------------
-    def _move(self, goal_handle: Any) -> Move.Result:
+    async def _move(self, goal_handle: Any) -> Move.Result:
         goal = goal_handle.request
         result = Move.Result()
         fields = MOVE_KINDS.get(goal.kind)
@@ -96,14 +96,21 @@ class MotionActions:
         motion_id = result.motion_id = reply.values["motion_id"]
         device = self.core.device
         canceled = False
-        while not device.wait(motion_id, self.period):
+
+        def over() -> bool | None:
+            """True once the move retired; a cancel stops the arm (and is then waited out)."""
+            nonlocal canceled
             if goal_handle.is_cancel_requested and not canceled:
                 self.core.stop()
                 canceled = True
-            current, _, progress, queued = self.core.device.status()
+            return True if is_over(device, motion_id) else None
+
+        def feedback() -> None:
+            current, _, progress, queued = device.status()
             goal_handle.publish_feedback(Move.Feedback(
                 motion_id=current, progress=progress if current == motion_id else 0.0,
                 queue_length=queued))
+        await self.watch.until(over, feedback)
         result.completed = not device.was_discarded(motion_id)
         self._where(result)
         if canceled:

@@ -7,10 +7,9 @@ from typing import Any, Callable
 
 import pinocchio as pin
 from acti_msgs.msg import Alarm, ArmState, ReturnId
-from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
-from acti_bringup.adapter import serve_operations
+from acti_bringup.adapter import Plane, serve_operations
 from acti_bringup.parameters import Setting, declare_config, sync_parameters
 from acti_bringup.simulation import Simulation
 from acti_middle_node.actions import ActionConfig, MotionActions
@@ -57,17 +56,17 @@ class ArmNode(Node):
                                   read=lambda g=g: g(self.core))
                     for name, (f, g) in ARM_SETTINGS.items()}
         self.core = ArmCore(self.simulation.executor, declare_config(self, ArmConfig, settings))
-        serve_operations(self, self.core, OPERATIONS, write_return_id)
-        group = ReentrantCallbackGroup()
+        self.motion, self.goals = Plane(self, "motion"), Plane(self, "goals")
+        serve_operations(self, self.motion, self.core, OPERATIONS, write_return_id)
         actions = declare_config(self, ActionConfig)
         topics = declare_config(self, TopicConfig)
         if actions.feedback_rate_hz <= 0 or topics.state_rate_hz <= 0:
             raise ValueError("feedback_rate_hz and state_rate_hz must be > 0")
-        self.actions = MotionActions(self, self.core, group, actions)
-        self.programs = ProgramAction(self, self.core, group, actions.feedback_rate_hz,
+        self.actions = MotionActions(self.goals, self.core, actions)
+        self.programs = ProgramAction(self.goals, self.core, actions.feedback_rate_hz,
                                       declare_config(self, ProgramDefaults))
         self._state = self.create_publisher(ArmState, "~/state", 10)
-        self.create_timer(1.0 / topics.state_rate_hz, self._publish_state, callback_group=group)
+        self.create_timer(1.0 / topics.state_rate_hz, self._publish_state)
 
     def _publish_state(self) -> None:
         sync_parameters(self)             # settings changed through the services, as parameters

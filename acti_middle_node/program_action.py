@@ -1,9 +1,10 @@
 """~/run_program (acti_msgs/action/RunProgram): a STROLIC program run on the arm, with its
 progress as feedback; canceling stops the program and the arm.
 
-The program runs on a thread of its own (`acti_motion.programs.run.ProgramRun`), never on the
-executor's threads, which go on serving stop, pause, resume and get_state meanwhile; the goal's
-callback only publishes feedback and waits for the end. One program runs at a time. The robot's
+The program runs on a thread of its own (`acti_motion.programs.run.ProgramRun`), never on an
+executor's thread; the goal's coroutine awaits its end on the goal plane without holding that
+thread (`acti_bringup.waiting.Watch`) and publishes feedback meanwhile, while the control plane
+serves stop, pause, resume and get_state. One program runs at a time. The robot's
 digital I/O (`RobotIO`) lives as long as the node: outputs keep their values from run to run.
 """
 from __future__ import annotations
@@ -14,9 +15,10 @@ from typing import Any
 
 from acti_msgs.action import RunProgram
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
-from rclpy.node import Node
 
+from acti_bringup.adapter import Plane
 from acti_bringup.conversions import fill
+from acti_bringup.waiting import Watch
 from acti_motion.arm.core import ArmCore
 from acti_motion.programs.run import ProgramRun, Status
 from acti_motion.programs.robot import ProgramDefaults, RobotIO
@@ -26,19 +28,19 @@ from strolic.errors import StrolicError
 class ProgramAction:
     """~/run_program of one ArmCore."""
 
-    def __init__(self, node: Node, core: ArmCore, group: Any, feedback_rate_hz: float,
+    def __init__(self, plane: Plane, core: ArmCore, feedback_rate_hz: float,
                  defaults: ProgramDefaults) -> None:
-        self.node, self.core, self.defaults = node, core, defaults
-        self.period = 1.0 / feedback_rate_hz
+        self.node, self.core, self.defaults = plane.owner, core, defaults
+        self.watch = Watch(plane, 1.0 / feedback_rate_hz)
         self.io = RobotIO()
         self._busy = False
         self._current: ProgramRun | None = None
         self._lock = threading.Lock()
-        self.server = ActionServer(node, RunProgram, "~/run_program", self._execute,
-                                   callback_group=group, goal_callback=self._admit,
-                                   cancel_callback=self._cancel)
-        # the node stops: so does the run. A method: rclpy calls what a plain function returns
-        node.context.on_shutdown(self._on_shutdown)
+        self.server = ActionServer(plane, RunProgram, plane.name("run_program"), self._execute,
+                                   goal_callback=self._admit, cancel_callback=self._cancel)
+        # the node stops: so does the run. A method returning None: rclpy calls what the
+        # callback returns, so a lambda returning a CancelResponse crashed the shutdown
+        plane.context.on_shutdown(self._cancel_run)
 
     def _admit(self, _goal: Any) -> GoalResponse:
         with self._lock:
@@ -48,25 +50,25 @@ class ProgramAction:
             self._busy = True
             return GoalResponse.ACCEPT
 
-    def _on_shutdown(self) -> None:
-        self._cancel(None)
-
     def _cancel(self, _goal: Any) -> CancelResponse:
         """At once: the program's waits end and the arm starts to decelerate now."""
+        self._cancel_run()
+        return CancelResponse.ACCEPT
+
+    def _cancel_run(self) -> None:
         run = self._current
         if run is not None:
             run.cancel()
-        return CancelResponse.ACCEPT
 
-    def _execute(self, goal_handle: Any) -> RunProgram.Result:
+    async def _execute(self, goal_handle: Any) -> RunProgram.Result:
         try:
-            return self._run(goal_handle)
+            return await self._run(goal_handle)
         finally:
             with self._lock:
                 self._busy = False
                 self._current = None
 
-    def _run(self, goal_handle: Any) -> RunProgram.Result:
+    async def _run(self, goal_handle: Any) -> RunProgram.Result:
         goal = goal_handle.request
         program = bytes(goal.code) if len(goal.code) else goal.text
         try:
@@ -79,12 +81,15 @@ class ProgramAction:
                                      exception_offset=_offset(error))
         self._current = run
         run.start()
-        while not run.join(self.period):
-            if goal_handle.is_cancel_requested or not self.node.context.ok():
-                run.cancel()
-            feedback = RunProgram.Feedback()
-            fill(feedback, dataclasses.asdict(run.progress()))
-            self._quietly_at_shutdown(goal_handle.publish_feedback, feedback)
+        # the run's end pokes the watch from a thread that only waits for it
+        threading.Thread(target=lambda: (run.join(), self.watch.poke()), name="program-end",
+                         daemon=True).start()
+
+        def feedback() -> None:
+            msg = RunProgram.Feedback()
+            fill(msg, dataclasses.asdict(run.progress()))
+            self._quietly_at_shutdown(goal_handle.publish_feedback, msg)
+        await self.watch.until(lambda: True if run.join(0) else None, feedback)
         r = run.result
         error = r.error
         self.node.get_logger().info(f"program {r.status.name.lower()} after {r.instructions} "

@@ -70,6 +70,7 @@ class Device:
         self.completed = 0
         self.discarded = 0
         self._discarded_ids: deque[tuple[int, int]] = deque(maxlen=256)
+        self._retire_listeners: list[Callable[[], None]] = []
 
     # --- called by cores (any thread) -------------------------------------------------------
     @property
@@ -241,6 +242,12 @@ class Device:
                 self.changed.wait(left)
             return True
 
+    def on_retire(self, fn: Callable[[], None]) -> None:
+        """Call fn() whenever motions retire (finish or are discarded): how waiters that hold no
+        thread (the action servers) learn of it. It runs on the retiring thread with the lock
+        held, so it must only signal (never block, never call back into the device)."""
+        self._retire_listeners.append(fn)
+
     def was_discarded(self, motion_id: int) -> bool:
         """True when motion `motion_id` was discarded by a stop (of the last 256 stops)."""
         with self.lock:
@@ -329,6 +336,7 @@ class Device:
         self.current = None
         self.revision += 1
         self.changed.notify_all()
+        self._announce_retired()
 
     def _end_of_queue(self) -> Any:
         """Where the device rests once everything queued now is over (a stop's rest point when
@@ -362,6 +370,11 @@ class Device:
             self.retired_id = max(self.retired_id, self.queue[-1].id)
             self.queue.clear()
             self.changed.notify_all()
+            self._announce_retired()
+
+    def _announce_retired(self) -> None:
+        for fn in self._retire_listeners:
+            fn()
 
 
 StepListener = Callable[[World], None]

@@ -1,4 +1,10 @@
-"""Shared pieces of the benchmarks: DDS kept local, node processes, latency statistics."""
+"""Shared pieces of the benchmarks: DDS kept local, node processes, an honest latency method.
+
+The method: one client node whose own cost stays flat over the run (`RosClient` waits with a
+`spin_once` loop of its own; each table shows the p50 of the first and the last 10 % of its
+calls), and the baseline interleaved with the measured calls (A B A B …), so that drift of the
+machine or of the client cancels out of the ratios.
+"""
 from __future__ import annotations
 
 import os
@@ -15,38 +21,106 @@ os.environ.setdefault("ROS_DOMAIN_ID", str(101 + os.getpid() % 60))
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 os.environ["FASTDDS_BUILTIN_TRANSPORTS"] = "UDPv4"
 
-from acti_bringup.harness import NodeProcess, RosClient  # noqa: E402
+from acti_bringup.harness import Actions, NodeProcess, RosClient  # noqa: E402
+from bench.trigger_server import KIND as BARE_EXECUTOR  # noqa: E402
+
+BARE = "/bare_trigger/trigger"
 
 
 @contextmanager
-def running(module: str, *params: str) -> Iterator[NodeProcess]:
+def running(module: str, *params: str, args: tuple[str, ...] = ()) -> Iterator[NodeProcess]:
     with tempfile.TemporaryDirectory() as d:
-        node = NodeProcess(module, os.path.join(d, "node.log"), *params)
+        node = NodeProcess(module, os.path.join(d, "node.log"), *params, args=args)
         try:
             yield node
         finally:
             node.stop()
 
 
-def latencies(fn: Callable[[], object], n: int, warmup: int = 30) -> np.ndarray:
-    """Wall seconds of n calls of fn after a warm-up."""
+def bare_call(ros: RosClient) -> Callable[[], object]:
+    from std_srvs.srv import Trigger
+    return lambda: ros.call(Trigger, BARE)
+
+
+Calls = list[tuple[str, Callable[[], object]]]
+
+
+def interleaved(calls: Calls, n: int, warmup: int = 30) -> dict[str, np.ndarray]:
+    """Wall seconds of n rounds in which every call runs once, in the order given (A B A C …),
+    after `warmup` rounds; a name listed twice (the baseline between each measured call) pools
+    its samples."""
     for _ in range(warmup):
-        fn()
-    out = np.empty(n)
-    for i in range(n):
-        t0 = time.perf_counter()
-        fn()
-        out[i] = time.perf_counter() - t0
-    return out
+        for _name, fn in calls:
+            fn()
+    out: dict[str, list[float]] = {name: [] for name, _ in calls}
+    for _ in range(n):
+        for name, fn in calls:
+            t0 = time.perf_counter()
+            fn()
+            out[name].append(time.perf_counter() - t0)
+    return {name: np.array(sample) for name, sample in out.items()}
+
+
+def latencies(fn: Callable[[], object], n: int, warmup: int = 30) -> np.ndarray:
+    """Wall seconds of n calls of fn alone, after a warm-up (no baseline to interleave)."""
+    return interleaved([("calls", fn)], n, warmup)["calls"]
+
+
+def against(baseline: tuple[str, Callable[[], object]], measured: Calls) -> Calls:
+    """The baseline call before each measured one: A B A C A D …"""
+    return [c for m in measured for c in (baseline, m)]
+
+
+def p(sample: np.ndarray, q: float) -> float:
+    """The q-th percentile in ms."""
+    return float(np.percentile(sample, q)) * 1e3
 
 
 def row(name: str, sample: np.ndarray, baseline: np.ndarray | None = None) -> str:
-    p50, p99 = np.percentile(sample, 50) * 1e3, np.percentile(sample, 99) * 1e3
-    text = f"{name:<34} p50 {p50:7.3f} ms   p99 {p99:7.3f} ms"
+    """p50/p99, the ratios to the baseline, and the client's flatness (p50 of the first and the
+    last 10 % of the calls)."""
+    tenth = max(1, len(sample) // 10)
+    text = (f"{name:<42} p50 {p(sample, 50):7.3f} ms  p99 {p(sample, 99):7.3f} ms"
+            f"   first/last 10 % p50 {p(sample[:tenth], 50):6.3f} / {p(sample[-tenth:], 50):6.3f}")
     if baseline is not None:
-        b50, b99 = np.percentile(baseline, 50) * 1e3, np.percentile(baseline, 99) * 1e3
-        text += f"   ratio p50 {p50 / b50:5.2f}  p99 {p99 / b99:5.2f}"
+        text += (f"   ratio p50 {p(sample, 50) / p(baseline, 50):5.2f}"
+                 f"  p99 {p(sample, 99) / p(baseline, 99):5.2f}")
     return text
 
 
-__all__ = ["RosClient", "running", "latencies", "row"]
+def table(title: str, samples: dict[str, np.ndarray], baseline: str) -> None:
+    """Print the samples, each against the baseline sample taken interleaved with it."""
+    print(title)
+    print(f"(bare baseline: std_srvs/Trigger on rclpy's {BARE_EXECUTOR} executor, the kind the "
+          f"nodes' control plane runs on; client waits with its own spin_once loop)")
+    base = samples[baseline]
+    print(row(baseline, base))
+    for name, sample in samples.items():
+        if name != baseline:
+            print(row(name, sample, base))
+
+
+def cpu_seconds(pid: int) -> float:
+    """User + system CPU time a process has used so far."""
+    with open(f"/proc/{pid}/stat") as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def idle_cpu_percent(pid: int, seconds: float = 5.0) -> float:
+    """Share of one core a process uses over `seconds` of wall time."""
+    c0, t0 = cpu_seconds(pid), time.monotonic()
+    time.sleep(seconds)   # the measurement window itself
+    return 100.0 * (cpu_seconds(pid) - c0) / (time.monotonic() - t0)
+
+
+def worst_ratios(samples: dict[str, np.ndarray], baseline: str) -> tuple[float, float]:
+    """The largest p50 and p99 ratio of any measured call to the baseline."""
+    base = samples[baseline]
+    rest = [s for name, s in samples.items() if name != baseline]
+    return (max(p(s, 50) for s in rest) / p(base, 50), max(p(s, 99) for s in rest) / p(base, 99))
+
+
+__all__ = ["Actions", "RosClient", "running", "bare_call", "interleaved", "latencies", "against",
+           "row", "table", "p",
+           "worst_ratios", "idle_cpu_percent"]

@@ -5,7 +5,7 @@ import signal
 
 import pytest
 
-from acti_bringup.harness import NodeProcess, RosClient, wait_until  # noqa: F401
+from acti_bringup.harness import Actions, NodeProcess, RosClient, wait_until  # noqa: F401
 
 TEST_RATE = "real_time_factor:=4.0"
 
@@ -30,3 +30,4 @@ def node_fixture(module: str, *params: str):
         assert code in (0, -signal.SIGINT), f"{module} exited with {code}:\n{node.log()}"
         assert "Traceback" not in node.log(), f"{module} logged an exception:\n{node.log()}"
     return fixture
+

@@ -8,15 +8,13 @@ from acti_msgs import srv
 from acti_msgs.action import Move, WaitMotion
 from acti_msgs.msg import ArmState, CarPosWithElbow, CartesianSpeed, LimitValue
 from action_msgs.msg import GoalStatus
-from rclpy.action import ActionClient
 
 from acti_middle_node.operations import OPERATIONS
-from ros_harness import node_fixture, wait_until
+from ros_harness import Actions, node_fixture, wait_until
 
 arm_node = node_fixture("acti_middle_node", "queue_size:=4")
 ARM = "/acti_middle_node/"
 IDENTITY = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
-ACTION_TIMEOUT = 60.0
 
 
 def call(ros, name, srv_type, **fields):
@@ -36,38 +34,14 @@ def rel(dx=0.0, dy=0.0, dz=0.0):
     return CarPosWithElbow(car_pos=m, elbow=0.0, struct_flag=0)
 
 
-class Actions:
-    """Goals of one action over the test client's executor."""
-
-    def __init__(self, ros, action_type, name):
-        self.ros, self.type = ros, action_type
-        self.client = ActionClient(ros.node, action_type, ARM + name)
-        assert self.client.wait_for_server(timeout_sec=30.0)
-
-    def spin(self, future, timeout=ACTION_TIMEOUT):
-        self.ros.executor.spin_until_future_complete(future, timeout_sec=timeout)
-        assert future.done(), "no answer in time"
-        return future.result()
-
-    def send(self, feedback=None, **fields):
-        handle = self.spin(self.client.send_goal_async(
-            self.type.Goal(**fields), feedback_callback=feedback))
-        assert handle.accepted
-        return handle
-
-    def result(self, handle):
-        out = self.spin(handle.get_result_async())
-        return out.status, out.result
-
-
 @pytest.fixture(scope="module")
 def move(ros, arm_node):
-    return Actions(ros, Move, "move")
+    return Actions(ros, Move, ARM + "move")
 
 
 @pytest.fixture(scope="module")
 def wait_motion(ros, arm_node):
-    return Actions(ros, WaitMotion, "wait_motion")
+    return Actions(ros, WaitMotion, ARM + "wait_motion")
 
 
 def test_every_operation_is_a_service_plus_actions_and_state(ros, arm_node):

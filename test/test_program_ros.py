@@ -14,8 +14,8 @@ from acti_msgs.action import RunProgram
 from acti_msgs.msg import ArmState
 from action_msgs.msg import GoalStatus
 
-from ros_harness import node_fixture, wait_until
-from test_arm_ros import ARM, Actions, call
+from ros_harness import Actions, node_fixture, wait_until
+from test_arm_ros import ARM, call
 from strolic.text import assemble
 
 arm_node = node_fixture("acti_middle_node")
@@ -28,7 +28,7 @@ R = RunProgram.Result
 
 @pytest.fixture(scope="module")
 def programs(ros, arm_node):
-    return Actions(ros, RunProgram, "run_program")
+    return Actions(ros, RunProgram, ARM + "run_program")
 
 
 @pytest.fixture(scope="module")

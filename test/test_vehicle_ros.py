@@ -198,10 +198,10 @@ def test_wait_motion_action(ros, vehicle):
         feedback = []
         goal = client.send_goal_async(VehicleWaitMotion.Goal(motion_id=motion_id, timeout=20.0),
                                       feedback_callback=lambda f: feedback.append(f.feedback))
-        ros.executor.spin_until_future_complete(goal, timeout_sec=5.0)
+        assert ros.wait(goal, 5.0)
         assert goal.result().accepted
         result_future = goal.result().get_result_async()
-        ros.executor.spin_until_future_complete(result_future, timeout_sec=20.0)
+        assert ros.wait(result_future, 20.0)
         result = result_future.result().result
         assert result.success and result.completed and result.motion_id == motion_id
         moved = math.hypot(result.pos.x - start.x, result.pos.y - start.y)
@@ -209,9 +209,9 @@ def test_wait_motion_action(ros, vehicle):
         assert feedback and feedback[-1].current_motion_id == motion_id
         assert feedback[-1].current_label == "move_forward"
         bad = client.send_goal_async(VehicleWaitMotion.Goal(motion_id=motion_id + 100))
-        ros.executor.spin_until_future_complete(bad, timeout_sec=5.0)
+        assert ros.wait(bad, 5.0)
         result_future = bad.result().get_result_async()
-        ros.executor.spin_until_future_complete(result_future, timeout_sec=5.0)
+        assert ros.wait(result_future, 5.0)
         result = result_future.result().result
         assert not result.success and "never queued" in result.message
     finally:

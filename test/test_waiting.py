@@ -1,11 +1,16 @@
-"""wait_for_motion on a real Device: bad goals, completion, discard, timeout and cancel.
+"""wait_for_motion on a real Device, awaited on the test client's executor (rclpy): bad goals,
+completion (announced by the device from another thread), discard, timeout and cancel.
 
 The goal handle here is a plain recorder of what the server would be told; the ROS path of both
-~/wait_motion servers is tested over DDS in test_arm_ros.py and test_vehicle_ros.py."""
+~/wait_motion servers is tested over DDS in test_arm_ros.py, test_vehicle_ros.py and
+test_control_plane_ros.py."""
+import math
 import threading
 from dataclasses import dataclass
 
-from acti_bringup.waiting import wait_for_motion
+import pytest
+
+from acti_bringup.waiting import device_watch, wait_for_motion
 from acti_motion.executor import Device
 
 
@@ -38,35 +43,42 @@ def device_with(n: int) -> Device:
     return d
 
 
-def wait(device, goal, cancel=False, feedback=None):
-    return wait_for_motion(Handle(goal, cancel), device, 0.01, "stop",
-                           feedback or (lambda *status: None))
+@pytest.fixture
+def wait(ros):
+    def run(device, goal, cancel=False, feedback=None, period=0.01):
+        watch = device_watch(ros.node, device, period)
+        task = ros.executor.create_task(wait_for_motion(
+            Handle(goal, cancel), device, watch, "stop", feedback or (lambda *status: None)))
+        assert ros.wait(task, 10.0), "the wait never ended"
+        return task.result()
+    return run
 
 
-def test_negative_timeout_is_a_bad_goal():
-    out = wait(device_with(1), Goal(1, timeout=-1.0))
-    assert out.bad_goal and out.aborted and ">= 0" in out.message
+@pytest.mark.parametrize("timeout", [-1.0, math.nan, math.inf, -math.inf])
+def test_a_timeout_that_is_not_a_finite_number_of_seconds_is_a_bad_goal(wait, timeout):
+    out = wait(device_with(1), Goal(1, timeout=timeout))
+    assert out.bad_goal and out.aborted and "finite number of seconds >= 0" in out.message
 
 
-def test_a_motion_never_queued_is_a_bad_goal():
+def test_a_motion_never_queued_is_a_bad_goal(wait):
     out = wait(device_with(1), Goal(5))
     assert out.bad_goal and out.aborted and "never queued" in out.message
 
 
-def test_timeout_aborts_with_feedback_meanwhile():
+def test_timeout_aborts_with_feedback_meanwhile(wait):
     seen = []
     out = wait(device_with(2), Goal(2, timeout=0.05), feedback=lambda *s: seen.append(s))
     assert out.aborted and not out.bad_goal and "timed out" in out.message
     assert seen and seen[-1] == (0, "", 0.0, 2)
 
 
-def test_cancel_ends_the_wait_only():
+def test_cancel_ends_the_wait_only(wait):
     d = device_with(1)
     out = wait(d, Goal(1), cancel=True)
     assert out.end == "canceled" and d.queue_length == 1
 
 
-def test_discarded_motion_is_reported_not_completed():
+def test_discarded_motion_is_reported_not_completed(wait):
     d = device_with(2)
     d.stop(0.1)
     out = wait(d, Goal(0))
@@ -74,15 +86,15 @@ def test_discarded_motion_is_reported_not_completed():
     assert not out.completed and out.message == "discarded by stop"
 
 
-def test_completed_motion():
+def test_completed_motion_is_announced_by_the_device_at_once(wait):
     d = device_with(1)
+    # the device retires the motion on another thread; no tick of the watch is needed (period 10 s)
     threading.Timer(0.05, lambda: [d.tick(None, 0.6) for _ in range(3)]).start()
-    out = wait(d, Goal(1, timeout=5.0))
+    out = wait(d, Goal(1, timeout=5.0), period=10.0)
     assert out.end == "succeed" and out.completed and out.message == ""
 
 
 def test_goal_slots_reject_beyond_the_limit_and_free_a_slot_however_a_goal_ends(ros):
-    import pytest
     from rclpy.action import GoalResponse
 
     from acti_bringup.waiting import GoalSlots
@@ -92,8 +104,20 @@ def test_goal_slots_reject_beyond_the_limit_and_free_a_slot_however_a_goal_ends(
     assert slots.admit(None) == GoalResponse.ACCEPT
     assert slots.admit(None) == GoalResponse.REJECT
 
-    def failing(_handle):
+    async def failing(_handle):
         raise RuntimeError("goal failed")
-    with pytest.raises(RuntimeError):
-        slots.holding(failing)(None)
+    task = ros.executor.create_task(slots.holding(failing)(None))
+    with pytest.raises(RuntimeError, match="goal failed"):
+        ros.wait(task, 5.0)
     assert slots.admit(None) == GoalResponse.ACCEPT
+
+
+def test_a_stop_ends_the_wait_on_the_current_motion_only_once_it_is_at_rest(wait):
+    from acti_bringup.waiting import is_over
+    d = device_with(2)
+    d.tick(None, 0.1)                     # motion 1 runs, motion 2 waits behind it
+    d.stop(0.5)                           # 2 is discarded at once; 1 decelerates for 0.5 s
+    assert is_over(d, 2) and not is_over(d, 1)
+    threading.Timer(0.05, lambda: [d.tick(None, 0.1) for _ in range(10)]).start()
+    out = wait(d, Goal(1, timeout=5.0), period=10.0)
+    assert out.end == "succeed" and not out.completed and d.current is None

@@ -25,7 +25,7 @@ from rclpy.node import Node
 from sensor_msgs.msg import Joy
 from tf2_msgs.msg import TFMessage
 
-from acti_bringup.adapter import serve_operations
+from acti_bringup.adapter import Plane, serve_operations
 from acti_bringup.parameters import declare_config
 from acti_bringup.simulation import Simulation
 from acti_bringup.transforms import planar_transform, tf_publisher
@@ -96,8 +96,9 @@ class VehicleNode(Node):
         super().__init__("vehicle_node")
         self.simulation = simulation or Simulation(self)
         self.core = VehicleCore(self.simulation.executor, declare_config(self, VehicleConfig))
-        serve_operations(self, self.core, OPERATIONS, write_success)
-        self.wait_motion = WaitMotionServer(self, self.core, declare_config(self, WaitConfig))
+        self.motion, self.goals = Plane(self, "motion"), Plane(self, "goals")
+        serve_operations(self, self.motion, self.core, OPERATIONS, write_success)
+        self.wait_motion = WaitMotionServer(self.goals, self.core, declare_config(self, WaitConfig))
         self.frames = declare_config(self, FrameConfig)
         if self.frames.position_frame in ("", "odom", "base_link"):
             raise ValueError("position_frame must name a frame of its own, not odom or base_link")
@@ -107,8 +108,9 @@ class VehicleNode(Node):
         self._state = self.create_publisher(VehicleStatus, "~/state", 10)
         self._diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self._cmd_vel_clamped = False
-        self.create_subscription(Twist, "cmd_vel", self._on_cmd_vel, 10)
-        self.create_subscription(Joy, "joy", self._on_joy, 10)
+        # commands that move the base arrive on the motion plane, like the move services
+        self.motion.create_subscription(Twist, "cmd_vel", self._on_cmd_vel, 10)
+        self.motion.create_subscription(Joy, "joy", self._on_joy, 10)
         rate = self.simulation.config.rate_hz
         ex = self.simulation.executor
         ex.after_step(self._publish_odometry, every=max(1, round(rate / ODOM_RATE_HZ)))

@@ -1,0 +1,121 @@
+"""How a process serves its nodes: three planes, each on an executor and a thread of its own.
+
+- The control plane (stop, pause, resume, servo, get_state, the getters and setters, parameters,
+  the timers and topics) runs on rclpy's `EventsExecutor`: it keeps no wait set to rebuild on
+  every wake (48 % of the GIL under a getter storm with the MultiThreadedExecutor), so a call
+  costs about what a bare node's does. Nothing on it plans or waits.
+- The motion plane (the services that plan a move, cmd_vel/joy) runs on an `EventsExecutor` of
+  its own: planning for ms there never delays the control plane.
+- The goal plane (the action servers) runs on a `SingleThreadedExecutor`: goals are coroutines
+  that await (`acti_bringup.waiting`), which the EventsExecutor would poll without pause.
+
+Each executor is driven by a `spin_once` loop (the EventsExecutor's `spin()` serves nothing in
+this rclpy and neither honours SIGINT); SIGINT and SIGTERM are handled here, on the main thread.
+"""
+from __future__ import annotations
+
+import signal
+import threading
+from typing import Callable, Iterable
+
+import rclpy
+from rclpy.executors import Executor, SingleThreadedExecutor
+from rclpy.signals import SignalHandlerOptions
+from rclpy.experimental import EventsExecutor
+from rclpy.node import Node
+
+SPIN_TIMEOUT_S = 0.5        # a loop's longest sleep: how soon it notices it should end
+SIGNALS = (signal.SIGINT, signal.SIGTERM)
+_stop_requested = threading.Event()
+
+
+def catch_signals() -> None:
+    """SIGINT/SIGTERM only set a flag that `wait_for_signal` watches: a signal while the nodes
+    are still being built ends the process as cleanly as one while they serve."""
+    for s in SIGNALS:
+        signal.signal(s, lambda _signum, _frame: _stop_requested.set())
+
+
+def stop_requested() -> bool:
+    """SIGINT or SIGTERM came (after `catch_signals`)."""
+    return _stop_requested.is_set()
+
+
+def init(args: list[str]) -> None:
+    """rclpy.init with this module's signal handling instead of rclpy's."""
+    catch_signals()
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+
+
+class SpinLoop:
+    """One executor served by `spin_once` on a thread of its own until `stop()`."""
+
+    def __init__(self, executor: Executor, name: str) -> None:
+        self.executor, self.name = executor, name
+        self.error: BaseException | None = None
+        self._running = threading.Event()
+        self._thread = threading.Thread(target=self._loop, name=name, daemon=True)
+
+    def start(self) -> "SpinLoop":
+        self._running.set()
+        self._thread.start()
+        return self
+
+    @property
+    def alive(self) -> bool:
+        return self._thread.is_alive()
+
+    def _loop(self) -> None:
+        context = self.executor.context
+        try:
+            while self._running.is_set() and context.ok():
+                self.executor.spin_once(timeout_sec=SPIN_TIMEOUT_S)
+        except BaseException as e:  # ends the process's serving: the main thread reports it
+            if context.ok() and self._running.is_set():
+                self.error = e
+
+    def stop(self) -> None:
+        self._running.clear()
+        self.executor.wake()
+        self._thread.join(timeout=5.0)
+
+
+class Planes:
+    """The executors of one process, one per plane, and their loops."""
+
+    KINDS: dict[str, Callable[[], Executor]] = {
+        "control": EventsExecutor, "motion": EventsExecutor, "goals": SingleThreadedExecutor}
+
+    def __init__(self) -> None:
+        self.executors = {plane: kind() for plane, kind in self.KINDS.items()}
+        self._loops: list[SpinLoop] = []
+
+    def add(self, plane: str, nodes: Iterable[Node]) -> None:
+        for n in nodes:
+            self.executors[plane].add_node(n)
+
+    def start(self) -> None:
+        self._loops = [SpinLoop(ex, f"ros-{plane}").start() for plane, ex in self.executors.items()]
+
+    def serving(self) -> bool:
+        return all(loop.alive for loop in self._loops)
+
+    def errors(self) -> list[BaseException]:
+        return [loop.error for loop in self._loops if loop.error is not None]
+
+    def stop(self) -> None:
+        for loop in self._loops:
+            loop.stop()
+        for ex in self.executors.values():
+            ex.shutdown(timeout_sec=5.0)
+
+
+def wait_for_signal(still_serving: Callable[[], bool]) -> None:
+    """Block the main thread until SIGINT/SIGTERM (or until `still_serving()` says no).
+
+    The handlers are installed again: each EventsExecutor puts in its own when created.
+    """
+    catch_signals()
+    while not _stop_requested.wait(SPIN_TIMEOUT_S):
+        if not (still_serving() and rclpy.ok()):
+            return

@@ -1,0 +1,326 @@
+"""Stop always works: `stop`'s reply time and the time to rest of both devices of the main job
+while (a) a long move is being planned, (b) the queue is full, (c) the most action goals are
+held, (d) 8 client processes storm getters and moves; and the largest /clock gap during each.
+
+Each trial starts a motion, loads the job, calls a bare std_srvs/Trigger (the baseline, same
+moment, same load) and then `stop`. Rest is when the stopped motion retires (a ~/wait_motion
+goal on it answers). Ratios are against the bare round trip and the control period measured in
+the same run (the /clock increment). Goals: stop reply p99 <= 3x bare, rest within the decel
+time + 2 control periods, /clock never silent for more than 2 control periods.
+
+    python bench/bench_control_plane.py            (a few minutes)
+    python bench/bench_control_plane.py --storm S  (one storm client for S seconds: used by (d))
+"""
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+import threading
+import time
+from contextlib import contextmanager, nullcontext
+from dataclasses import dataclass
+from typing import Any, Callable, Iterator
+
+import numpy as np
+from common import Actions, RosClient, bare_call, p, running
+
+import rclpy
+from acti_msgs import srv
+from acti_msgs.action import VehicleWaitMotion, WaitMotion
+from acti_msgs.msg import CarPosWithElbow, VehiclePoint
+from rosgraph_msgs.msg import Clock
+
+from acti_bringup.spinning import init, stop_requested
+
+ARM, BASE = "/acti_middle_node/", "/vehicle_node/"
+TRIALS = 20
+MAX_GOALS = 4                       # max_action_goals and max_wait_goals of the job
+QUEUE = 8                           # queue_size of both devices
+STORM_CLIENTS = 8
+ARM_DECEL_S = 0.3                   # accel_time_joint
+BASE_DECEL_S = 300.0 / 500.0        # default velocity / default acceleration (translation)
+
+
+class Background:
+    """A second client node spun on a thread of its own: requests the main client does not wait
+    for (the long plan of (a)) and the /clock arrival times."""
+
+    def __init__(self) -> None:
+        import rclpy
+        from rclpy.executors import SingleThreadedExecutor
+        self.node = rclpy.create_node("bench_background")
+        self.clock_arrivals: list[float] = []
+        self.clock_values: list[float] = []
+        self.node.create_subscription(Clock, "/clock", self._on_clock, 100)
+        self.executor = SingleThreadedExecutor()
+        self.executor.add_node(self.node)
+        self._clients: dict[str, Any] = {}
+        self._thread = threading.Thread(target=self.executor.spin, daemon=True)
+        self._thread.start()
+
+    def _on_clock(self, msg: Clock) -> None:
+        self.clock_arrivals.append(time.monotonic())
+        self.clock_values.append(msg.clock.sec + msg.clock.nanosec * 1e-9)
+
+    def send(self, srv_type: type, name: str, **fields: Any) -> Any:
+        client = self._clients.get(name) or self._clients.setdefault(
+            name, self.node.create_client(srv_type, name))
+        assert client.wait_for_service(timeout_sec=30.0)
+        return client.call_async(srv_type.Request(**fields))
+
+    def largest_clock_gap(self, since: float, until: float) -> float:
+        t = np.array(self.clock_arrivals)
+        t = t[(t >= since) & (t <= until)]
+        return float(np.max(np.diff(t))) if len(t) > 1 else float("inf")
+
+    def control_period(self) -> float:
+        return float(np.median(np.diff(np.array(self.clock_values[-500:]))))
+
+    def close(self) -> None:
+        self.executor.shutdown()
+        self.node.destroy_node()
+
+
+@dataclass
+class Device:
+    name: str
+    path: str
+    wait_action: type
+    decel_s: float
+    start: Callable[[RosClient, int], int | None]  # a motion that runs seconds: its id (or None)
+    stop_srv: type
+    fill: Callable[[RosClient, int], Any]          # one more queued move
+    at_rest: Callable[[RosClient], bool]
+
+
+def arm_start(ros: RosClient, trial: int) -> int | None:
+    r = ros.call(srv.MovePTPJointRel, ARM + "move_ptp_joint_rel",
+                 joint_points=[30.0 if trial % 2 else -30.0] + [0.0] * 6)
+    return r.motion_id if r.return_id.id == 0 else None
+
+
+def ahead(ros: RosClient, forward: float, left: float = 0.0) -> VehiclePoint:
+    """A point `forward` mm ahead of the base and `left` mm to its left."""
+    pos = ros.call(srv.VehicleGetPosition, BASE + "get_position").pos
+    c, s = math.cos(math.radians(pos.theta)), math.sin(math.radians(pos.theta))
+    return VehiclePoint(x=pos.x + forward * c - left * s, y=pos.y + forward * s + left * c)
+
+
+def base_start(ros: RosClient, trial: int) -> int | None:
+    """A cruise 1.5 m ahead (the base takes a move only when Ready; cruise points add up)."""
+    r = ros.call(srv.VehicleMoveCruiseAbs, BASE + "move_cruise_abs",
+                 cruise_point=ahead(ros, 1500.0))
+    return r.motion_id if r.success else None
+
+
+DEVICES = [
+    Device("arm", ARM, WaitMotion, ARM_DECEL_S, arm_start, srv.Stop,
+           lambda ros, i: ros.call(srv.MovePTPJointRel, ARM + "move_ptp_joint_rel",
+                                   joint_points=[1.0 if i % 2 else -1.0] * 7),
+           lambda ros: not ros.call(srv.GetState, ARM + "get_state").state & 0x02),
+    Device("base", BASE, VehicleWaitMotion, BASE_DECEL_S, base_start, srv.VehicleStop,
+           lambda ros, i: ros.call(srv.VehicleMoveCruiseAbs, BASE + "move_cruise_abs",
+                                   cruise_point=ahead(ros, 1600.0 + 100.0 * i)),
+           lambda ros: ros.call(srv.VehicleGetState, BASE + "get_state").state == 0x010),
+]
+
+
+def prepare(ros: RosClient) -> None:
+    ros.call(srv.ServoON, ARM + "servo_on")
+    ros.call(srv.SetSpeedJoint, ARM + "set_speed_joint", spd_ratio=30)
+    ros.call(srv.SetSpeedCartesian, ARM + "set_speed_cartesian", spd_ratio=30)
+    ros.call(srv.SetAccelTimeJoint, ARM + "set_accel_time_joint", acl_time=ARM_DECEL_S)
+    ros.call(srv.VehicleSetPower, BASE + "set_power", on_off=True)
+    ros.call(srv.VehicleSetServo, BASE + "set_servo", on_off=True)
+
+
+def long_plan(ros: RosClient, bg: Background, device: Device, trial: int) -> Any:
+    """A request that plans for long: an 800 mm line for the arm, one more cruise point 3 m away
+    for the base (each plans from the end of the queue, sent by the background client)."""
+    if device.name == "arm":
+        m = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 800.0 if trial % 2 else -800.0,
+             0.0, 0.0, 1.0, 0.0]
+        return bg.send(srv.MoveLinearCartesianRel, ARM + "move_linear_cartesian_rel",
+                       car_point=CarPosWithElbow(car_pos=m))
+    return bg.send(srv.VehicleMoveCruiseAbs, BASE + "move_cruise_abs",
+                   cruise_point=ahead(ros, 3000.0, 1000.0 if trial % 2 else -1000.0))
+
+
+@dataclass
+class Figures:
+    reply: list[float]
+    bare: list[float]
+    rest: list[float]
+    clock_gap: float
+    lost: int            # trials with a call never answered (DDS lost it: see the README)
+
+
+Load = Callable[[Device, int, int], Any]      # (device, trial, its motion id) → what it holds
+
+
+def started(ros: RosClient, device: Device, trial: int) -> int:
+    """The trial's motion id, once accepted (a storm may have filled the queue: stop, retry)."""
+    for _ in range(100):
+        motion_id = device.start(ros, trial)
+        if motion_id is not None:
+            return motion_id
+        ros.call(device.stop_srv, device.path + "stop")
+        ros.spin_until(lambda: device.at_rest(ros), 10.0)
+    raise RuntimeError(f"{device.name}: no motion accepted in 100 tries")
+
+
+def run_trials(ros: RosClient, bg: Background, device: Device, load: Load,
+               waiter: Actions) -> Figures:
+    reply: list[float] = []
+    base: list[float] = []
+    rest: list[float] = []
+    lost = 0
+    for trial in range(-1, TRIALS):                     # trial -1 warms up (lazy imports)
+        if trial == 0:
+            reply.clear(), base.clear(), rest.clear()
+            lost, t0 = 0, time.monotonic()
+        try:
+            trial_figures(ros, bg, device, load, waiter, trial, reply, base, rest)
+        except TimeoutError:
+            lost += 1
+            ros.call(device.stop_srv, device.path + "stop")
+    return Figures(reply, base, rest, bg.largest_clock_gap(t0, time.monotonic()), lost)
+
+
+def trial_figures(ros: RosClient, bg: Background, device: Device, load: Load, waiter: Actions,
+                  trial: int, reply: list, base: list, rest: list) -> None:
+    """One trial: start, load, bare call, stop, rest; the figures appended."""
+    bare = bare_call(ros)
+    motion_id = started(ros, device, trial)
+    current = []
+    goal = waiter.send(lambda f: current.append(f.feedback.current_motion_id),
+                       motion_id=motion_id, timeout=30.0)
+    result = goal.get_result_async()
+    if not ros.spin_until(lambda: motion_id in current, 30.0):
+        raise TimeoutError("the motion never ran")
+    held = load(device, trial, motion_id)
+    t = time.perf_counter()
+    bare()
+    base.append(time.perf_counter() - t)
+    t = time.perf_counter()
+    ros.call(device.stop_srv, device.path + "stop")
+    reply.append(time.perf_counter() - t)
+    if not ros.wait(result, 30.0):
+        raise TimeoutError("the stopped motion never retired")
+    rest.append(time.perf_counter() - t)
+    ros.call(device.stop_srv, device.path + "stop")     # what a load queued meanwhile
+    if isinstance(held, list):
+        for future in held:                              # held goals end with the motion
+            ros.wait(future, 30.0)
+
+
+@contextmanager
+def storm(seconds: float) -> Iterator[None]:
+    procs = [subprocess.Popen([sys.executable, os.path.abspath(__file__), "--storm",
+                               str(seconds)], stdout=subprocess.DEVNULL)
+             for _ in range(STORM_CLIENTS)]
+    try:
+        time.sleep(5.0)                     # the storm clients found the nodes and run
+        yield
+    finally:
+        for proc in procs:
+            proc.terminate()
+            proc.wait(timeout=30)
+
+
+def storm_client(seconds: float) -> None:
+    """One storm client: getters of both nodes and small moves, as fast as it can, until
+    `seconds` pass or SIGTERM comes."""
+    init(sys.argv)
+    ros = RosClient(f"bench_storm_{os.getpid()}", call_timeout=5.0)
+    calls = [lambda: ros.call(srv.GetState, ARM + "get_state"),
+             lambda: ros.call(srv.GetFeedbackPosJoint, ARM + "get_feedback_pos_joint"),
+             lambda: ros.call(srv.VehicleGetPosition, BASE + "get_position"),
+             lambda: ros.call(srv.MovePTPJointRel, ARM + "move_ptp_joint_rel",
+                              joint_points=[0.2] * 7),
+             lambda: ros.call(srv.MovePTPJointRel, ARM + "move_ptp_joint_rel",
+                              joint_points=[-0.2] * 7),
+             lambda: ros.call(srv.VehicleMoveTurn, BASE + "move_turn", theta=0.5),
+             lambda: ros.call(srv.VehicleMoveTurn, BASE + "move_turn", theta=-0.5)]
+    end = time.monotonic() + seconds
+    i = 0
+    while time.monotonic() < end and not stop_requested():
+        try:
+            calls[i % len(calls)]()
+        except TimeoutError:                # a storm goes on (a lost call is DDS's, not ours)
+            pass
+        i += 1
+    ros.close()
+    rclpy.try_shutdown()
+
+
+def scenarios(ros: RosClient, bg: Background) -> dict[str, tuple[Load, Callable[[], Any]]]:
+    """name → (per-trial load, context around the whole case)."""
+    def planning(device: Device, trial: int, _motion_id: int) -> Any:
+        future = long_plan(ros, bg, device, trial)
+        time.sleep(0.003)                   # the plan is under way when stop is called
+        return future
+
+    def full_queue(device: Device, _trial: int, _motion_id: int) -> None:
+        for i in range(QUEUE):
+            device.fill(ros, i)
+
+    def most_goals(device: Device, _trial: int, motion_id: int) -> list:
+        """All the slots but the trial's own wait, on the trial's motion: the results."""
+        goals = Actions(ros, device.wait_action, device.path + "wait_motion")
+        return [goals.send(motion_id=motion_id, timeout=60.0).get_result_async()
+                for _ in range(MAX_GOALS - 1)]
+
+    def nothing(_device: Device, _trial: int, _motion_id: int) -> None:
+        return None
+
+    return {
+        "(a) a long move being planned": (planning, nullcontext),
+        "(b) the queue full": (full_queue, nullcontext),
+        "(c) the most action goals held": (most_goals, nullcontext),
+        "(d) 8 clients storm getters and moves": (nothing, lambda: storm(seconds=600.0)),
+    }
+
+
+def ms(x: float) -> str:
+    return f"{x * 1e3:7.2f}"
+
+
+def main() -> None:
+    ros = RosClient(call_timeout=5.0)
+    params = (f"max_action_goals:={MAX_GOALS}", f"max_wait_goals:={MAX_GOALS}",
+              f"queue_size:={QUEUE}")
+    with running("bench.trigger_server"), running("acti_bringup", *params):
+        bg = Background()
+        prepare(ros)
+        assert ros.spin_until(lambda: len(bg.clock_values) > 100, 30.0), "no /clock"
+        period = bg.control_period()
+        print(f"stop under load, main job, {TRIALS} trials per case; control period "
+              f"{period * 1e3:.2f} ms (from /clock); times in ms")
+        print(f"{'case':<40} {'dev':<5} {'bare p50/p99':>15} {'stop reply p50/p99/max':>25} "
+              f"{'ratio p99':>9} {'rest p50/p99/max':>25} {'goal':>7} {'/clock gap':>10}")
+        for name, (load, context) in scenarios(ros, bg).items():
+            with context():
+                for device in DEVICES:
+                    waiter = Actions(ros, device.wait_action, device.path + "wait_motion")
+                    f = run_trials(ros, bg, device, load, waiter)
+                    reply, rest = np.array(f.reply), np.array(f.rest)
+                    goal = device.decel_s + 2 * period
+                    print(f"{name:<40} {device.name:<5} {p(np.array(f.bare), 50):7.2f}/"
+                          f"{p(np.array(f.bare), 99):7.2f} {p(reply, 50):7.2f}/{p(reply, 99):7.2f}/"
+                          f"{reply.max() * 1e3:8.2f} {p(reply, 99) / p(np.array(f.bare), 99):9.2f}"
+                          f" {p(rest, 50):7.1f}/{p(rest, 99):7.1f}/{rest.max() * 1e3:7.1f}"
+                          f" {goal * 1e3:7.1f} {f.clock_gap * 1e3:7.1f} "
+                          f"({f.clock_gap / period:.1f} periods)"
+                          + (f"  {f.lost} trials lost a call" if f.lost else ""))
+        bg.close()
+    ros.close()
+
+
+if __name__ == "__main__":
+    if len(sys.argv) == 3 and sys.argv[1] == "--storm":
+        storm_client(float(sys.argv[2]))
+    else:
+        main()

@@ -1,0 +1,172 @@
+"""The control plane over DDS on the main job (both nodes, one process): with more action goals
+offered than the bound, the goals beyond it are rejected and stop, get_state and resume are
+answered at once while the others wait; ~/wait_motion's timeout, cancel, discarded and refused
+(NaN, inf, negative timeout) cases for the arm and the base."""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import pytest
+from acti_msgs import srv
+from acti_msgs.action import Move, VehicleWaitMotion, WaitMotion
+from action_msgs.msg import GoalStatus
+
+from ros_harness import Actions, node_fixture, wait_until
+
+ARM_GOALS, BASE_GOALS = 3, 2
+job = node_fixture("acti_bringup", f"max_action_goals:={ARM_GOALS}",
+                   f"max_wait_goals:={BASE_GOALS}")
+ARM, BASE = "/acti_middle_node/", "/vehicle_node/"
+ANSWER_S = 2.0          # a control call's answer, however loaded the machine (typically < 2 ms)
+
+
+@dataclass(frozen=True)
+class Device:
+    """What the tests need of one device: how to start a long motion and stop it, and how its
+    wait result says refused."""
+    name: str
+    action: type
+    start_long_motion: Callable[[Any], int]
+    stop: Callable[[Any], Any]
+    moving: Callable[[Any], bool]
+    refused: Callable[[Any], bool]
+    bound: int
+
+
+def arm_long_motion(ros) -> int:
+    ros.call(srv.Stop, ARM + "stop")
+    ros.call(srv.ClearAlarms, ARM + "clear_alarms")
+    assert ros.call(srv.ServoON, ARM + "servo_on").return_id.id == 0
+    assert ros.call(srv.SetSpeedJoint, ARM + "set_speed_joint", spd_ratio=5).return_id.id == 0
+    assert wait_until(lambda: not arm_moving(ros), 20.0)
+    q = ros.call(srv.GetFeedbackPosJoint, ARM + "get_feedback_pos_joint").pos
+    r = ros.call(srv.MovePTPJointRel, ARM + "move_ptp_joint_rel",
+                 joint_points=[-40.0 if q[0] > 0 else 40.0] + [0.0] * 6)
+    assert r.return_id.id == 0, r.return_id.comment
+    return r.motion_id
+
+
+def arm_moving(ros) -> bool:
+    return bool(ros.call(srv.GetState, ARM + "get_state").state & 0x02)
+
+
+def base_long_motion(ros) -> int:
+    ros.call(srv.VehicleStop, BASE + "stop")
+    assert ros.call(srv.VehicleSetPower, BASE + "set_power", on_off=True).success
+    assert ros.call(srv.VehicleSetServo, BASE + "set_servo", on_off=True).success
+    assert wait_until(lambda: base_state(ros) == 0x010, 20.0)
+    r = ros.call(srv.VehicleMoveTurn, BASE + "move_turn", theta=720.0)
+    assert r.success, r.message
+    return r.motion_id
+
+
+def base_state(ros) -> int:
+    return ros.call(srv.VehicleGetState, BASE + "get_state").state
+
+
+DEVICES = [
+    Device("arm", WaitMotion, arm_long_motion, lambda ros: ros.call(srv.Stop, ARM + "stop"),
+           arm_moving, lambda r: r.return_id.id == -3, ARM_GOALS),
+    Device("base", VehicleWaitMotion, base_long_motion,
+           lambda ros: ros.call(srv.VehicleStop, BASE + "stop"),
+           lambda ros: base_state(ros) == 0x011, lambda r: not r.success, BASE_GOALS),
+]
+PATH = {"arm": ARM, "base": BASE}
+
+
+@pytest.fixture(params=DEVICES, ids=[d.name for d in DEVICES])
+def device(request, ros, job):
+    d = request.param
+    yield d
+    d.stop(ros)
+    assert job.alive()
+
+
+def waits(ros, device: Device) -> Actions:
+    return Actions(ros, device.action, PATH[device.name] + "wait_motion")
+
+
+def timed(fn: Callable[[], Any]) -> tuple[Any, float]:
+    t0 = time.monotonic()
+    out = fn()
+    return out, time.monotonic() - t0
+
+
+def test_goals_beyond_the_bound_are_rejected_and_stop_is_answered_while_the_rest_wait(ros, job):
+    arm_id = arm_long_motion(ros)
+    base_id = base_long_motion(ros)
+    arm_wait = Actions(ros, WaitMotion, ARM + "wait_motion")
+    arm_move = Actions(ros, Move, ARM + "move")
+    base_wait = Actions(ros, VehicleWaitMotion, BASE + "wait_motion")
+    # more goals than both bounds: waits for the long motions, and ~/move goals queued behind
+    offered = ([arm_wait.offer(motion_id=arm_id) for _ in range(ARM_GOALS)]
+               + [arm_move.offer(kind="move_ptp_joint_rel", joint_points=[1.0] * 7)
+                  for _ in range(2)])
+    base_offered = [base_wait.offer(motion_id=base_id) for _ in range(BASE_GOALS + 2)]
+    accepted = [h for h in offered if h.accepted]
+    base_accepted = [h for h in base_offered if h.accepted]
+    assert len(accepted) == ARM_GOALS and len(base_accepted) == BASE_GOALS
+    assert arm_moving(ros) and base_state(ros) == 0x011
+
+    for name, fn in (("get_state", lambda: ros.call(srv.GetState, ARM + "get_state")),
+                     ("pause", lambda: ros.call(srv.Pause, ARM + "pause")),
+                     ("resume", lambda: ros.call(srv.Resume, ARM + "resume")),
+                     ("base get_state", lambda: base_state(ros))):
+        _, took = timed(fn)
+        assert took < ANSWER_S, f"{name} took {took:.3f} s with the goals held"
+    reply, took = timed(lambda: ros.call(srv.Stop, ARM + "stop"))
+    assert reply.return_id.id == 0 and took < ANSWER_S
+    reply, took = timed(lambda: ros.call(srv.VehicleStop, BASE + "stop"))
+    assert reply.success and took < ANSWER_S
+
+    for handle in accepted:
+        status, result = arm_wait.result(handle)
+        assert status == GoalStatus.STATUS_SUCCEEDED and not result.completed
+    for handle in base_accepted:
+        status, result = base_wait.result(handle)
+        assert status == GoalStatus.STATUS_SUCCEEDED and not result.completed
+        assert "discarded by" in result.message
+    # the slots are free again
+    assert arm_wait.offer(motion_id=0).accepted and base_wait.offer(motion_id=0).accepted
+
+
+def test_wait_motion_times_out_and_the_motion_goes_on(ros, device):
+    motion_id = device.start_long_motion(ros)
+    goals = waits(ros, device)
+    status, result = goals.result(goals.send(motion_id=motion_id, timeout=0.3))
+    assert status == GoalStatus.STATUS_ABORTED and not result.completed
+    assert device.moving(ros)
+
+
+def test_wait_motion_cancel_ends_the_wait_only(ros, device):
+    motion_id = device.start_long_motion(ros)
+    goals = waits(ros, device)
+    feedback = []
+    handle = goals.send(lambda f: feedback.append(f.feedback), motion_id=motion_id)
+    assert ros.spin_until(lambda: bool(feedback), 10.0), "no feedback while waiting"
+    goals.cancel(handle)
+    status, result = goals.result(handle)
+    assert status == GoalStatus.STATUS_CANCELED and not result.completed
+    assert device.moving(ros)
+
+
+def test_wait_motion_reports_a_discarded_motion(ros, device):
+    motion_id = device.start_long_motion(ros)
+    goals = waits(ros, device)
+    handle = goals.send(motion_id=motion_id, timeout=60.0)
+    device.stop(ros)
+    status, result = goals.result(handle)
+    assert status == GoalStatus.STATUS_SUCCEEDED
+    assert result.motion_id == motion_id and not result.completed
+
+
+@pytest.mark.parametrize("timeout", [math.nan, math.inf, -1.0])
+def test_wait_motion_refuses_a_timeout_that_is_not_finite_and_positive(ros, device, timeout):
+    goals = waits(ros, device)
+    status, result = goals.result(goals.send(motion_id=0, timeout=timeout))
+    assert status == GoalStatus.STATUS_ABORTED and device.refused(result)
+    message = result.return_id.comment if device.name == "arm" else result.message
+    assert "finite number of seconds" in message

@@ -1,0 +1,79 @@
+"""The serving planes (`acti_bringup.spinning`) on rclpy's EventsExecutor, explicitly: a spin_once
+loop serves services and timers and ends at once when stopped; a guard condition is what the
+EventsExecutor cannot serve (why goals have a plane of their own); and every way of running the
+nodes ends cleanly on SIGINT and SIGTERM (exit 0, no traceback)."""
+from __future__ import annotations
+
+import signal
+import time
+
+import pytest
+from acti_msgs.srv import GetState, VehicleGetState
+from rclpy.experimental import EventsExecutor
+from std_srvs.srv import Trigger
+
+from acti_bringup.spinning import SPIN_TIMEOUT_S, SpinLoop
+from ros_harness import NodeProcess, wait_until
+
+
+@pytest.fixture
+def events_loop(ros):
+    """A node on an EventsExecutor driven by a SpinLoop; the process's signal handlers are put
+    back afterwards (the EventsExecutor installs its own)."""
+    saved = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    node = ros.rclpy.create_node("spin_loop_test")
+    executor = EventsExecutor()
+    executor.add_node(node)
+    loop = SpinLoop(executor, "test-events")
+    yield node, loop
+    loop.stop()
+    executor.shutdown()
+    node.destroy_node()
+    for s, handler in saved.items():
+        signal.signal(s, handler)
+
+
+def test_a_spin_loop_serves_services_and_timers_and_stops_at_once(ros, events_loop):
+    node, loop = events_loop
+    ticks = []
+    node.create_timer(0.01, lambda: ticks.append(time.monotonic()))
+
+    def ping(_request, response):
+        response.success = True
+        return response
+    node.create_service(Trigger, "~/ping", ping)
+    loop.start()
+    for _ in range(20):
+        assert ros.call(Trigger, "/spin_loop_test/ping").success
+    assert ros.spin_until(lambda: len(ticks) >= 10, 5.0), "the timer did not fire"
+    t0 = time.monotonic()
+    loop.stop()
+    assert not loop.alive and time.monotonic() - t0 < SPIN_TIMEOUT_S
+    assert loop.error is None
+
+
+def test_a_guard_condition_is_refused_by_the_events_executor(ros, events_loop):
+    node, loop = events_loop
+    node.create_guard_condition(lambda: None)
+    loop.start()
+    assert ros.spin_until(lambda: not loop.alive, 5.0)
+    assert "Guard conditions not supported" in str(loop.error)
+
+
+ARM_UP = (GetState, "/acti_middle_node/get_state")
+BASE_UP = (VehicleGetState, "/vehicle_node/get_state")
+
+
+@pytest.mark.parametrize("module, up, signum", [
+    ("acti_bringup", ARM_UP, signal.SIGINT), ("acti_bringup", BASE_UP, signal.SIGTERM),
+    ("acti_middle_node", ARM_UP, signal.SIGTERM), ("vehicle_node", BASE_UP, signal.SIGINT)])
+def test_the_nodes_end_cleanly_on_a_signal(ros, tmp_path, module, up, signum):
+    node = NodeProcess(module, str(tmp_path / "node.log"))
+    try:
+        assert wait_until(lambda: "services under" in node.log(), 60.0), node.log()
+        ros.call(*up)                                   # serving
+        node.proc.send_signal(signum)
+        assert node.proc.wait(timeout=15.0) == 0, node.log()
+    finally:
+        node.stop()
+    assert "Traceback" not in node.log(), node.log()
