@@ -112,14 +112,6 @@ def accept_cancel(watch: Watch) -> Callable[[Any], CancelResponse]:
     return cancel
 
 
-def is_over(device: Device, motion_id: int) -> bool:
-    """Motion `motion_id` finished or was discarded. `retired_id` alone is not enough: a stop
-    retires the queue behind the current motion at once while the current one still
-    decelerates."""
-    current = device.current
-    return device.retired_id >= motion_id and (current is None or current.id != motion_id)
-
-
 def device_watch(node: Node, device: Device, period: float) -> Watch:
     """A watch poked whenever `device` retires a motion."""
     watch = Watch(node, period)
@@ -171,7 +163,7 @@ async def wait_for_motion(goal_handle: Any, device: Device, watch: Watch, discar
     deadline = time.monotonic() + goal.timeout if goal.timeout > 0 else math.inf
 
     def outcome() -> WaitOutcome | None:
-        if is_over(device, target):
+        if device.is_over(target):
             completed = not device.was_discarded(target)
             return WaitOutcome(target, "succeed", completed,
                                message="" if completed else f"discarded by {discarded_by}")

@@ -15,8 +15,7 @@ from rclpy.action import ActionServer
 
 from acti_bringup.adapter import Plane
 from acti_bringup.conversions import fill, to_core
-from acti_bringup.waiting import (GoalSlots, accept_cancel, device_watch, is_over,
-                                   wait_for_motion)
+from acti_bringup.waiting import GoalSlots, accept_cancel, device_watch, wait_for_motion
 from acti_motion.arm.core import ArmCore
 from acti_motion.replies import Reply, ReturnCode
 
@@ -103,7 +102,7 @@ class MotionActions:
             if goal_handle.is_cancel_requested and not canceled:
                 self.core.stop()
                 canceled = True
-            return True if is_over(device, motion_id) else None
+            return True if device.is_over(motion_id) else None
 
         def feedback() -> None:
             current, _, progress, queued = device.status()

@@ -230,17 +230,12 @@ class Device:
             self.hold = self.queued_end = rest
             self.changed.notify_all()
 
-    def wait(self, motion_id: int, timeout: float | None) -> bool:
-        """Block until motion `motion_id` (0: everything queued now) is over; False on timeout."""
-        deadline = None if timeout is None else time.monotonic() + timeout
-        with self.lock:
-            target = self.last_id if motion_id <= 0 else motion_id
-            while self.retired_id < target:
-                left = None if deadline is None else deadline - time.monotonic()
-                if left is not None and left <= 0:
-                    return False
-                self.changed.wait(left)
-            return True
+    def is_over(self, motion_id: int) -> bool:
+        """Motion `motion_id` finished or was discarded. `retired_id` alone is not enough: a stop
+        retires the queue behind the current motion at once while the current one still
+        decelerates."""
+        current = self.current
+        return self.retired_id >= motion_id and (current is None or current.id != motion_id)
 
     def on_retire(self, fn: Callable[[], None]) -> None:
         """Call fn() whenever motions retire (finish or are discarded): how waiters that hold no

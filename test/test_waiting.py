@@ -113,11 +113,10 @@ def test_goal_slots_reject_beyond_the_limit_and_free_a_slot_however_a_goal_ends(
 
 
 def test_a_stop_ends_the_wait_on_the_current_motion_only_once_it_is_at_rest(wait):
-    from acti_bringup.waiting import is_over
     d = device_with(2)
     d.tick(None, 0.1)                     # motion 1 runs, motion 2 waits behind it
     d.stop(0.5)                           # 2 is discarded at once; 1 decelerates for 0.5 s
-    assert is_over(d, 2) and not is_over(d, 1)
+    assert d.is_over(2) and not d.is_over(1)
     threading.Timer(0.05, lambda: [d.tick(None, 0.1) for _ in range(10)]).start()
     out = wait(d, Goal(1, timeout=5.0), period=10.0)
     assert out.end == "succeed" and not out.completed and d.current is None
