@@ -1,4 +1,5 @@
-"""The main job: both nodes in one process, sharing one world and one motion-queue executor.
+"""The main job: both nodes in one process, sharing one world and one motion-queue executor,
+and the live browser view of them (node `acti_view`).
 
     python -m acti_bringup [--ros-args ...]
 """
@@ -8,6 +9,7 @@ import sys
 
 import rclpy
 
+from acti_bringup.view import ViewNode
 from acti_middle_node.node import ArmNode
 from vehicle_node.node import VehicleNode
 
@@ -16,7 +18,8 @@ def main(args: list[str] | None = None) -> None:
     rclpy.init(args=sys.argv if args is None else args)
     arm = ArmNode()
     vehicle = VehicleNode(simulation=arm.simulation)
-    arm.simulation.spin(arm, vehicle)
+    view = ViewNode(arm.simulation, arm.core, vehicle.core)
+    arm.simulation.spin(arm, vehicle, view)
 
 
 if __name__ == "__main__":

@@ -144,6 +144,16 @@ class World:
         yaw = self._p.getEulerFromQuaternion(orn)[2]
         return float(pos[0]), float(pos[1]), float(yaw)
 
+    def base_link_pose(self) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+        """Ground-truth position (m) and quaternion (x, y, z, w) of the base_link frame in the
+        world (PyBullet reports the base's inertial frame; its offset is taken out here)."""
+        p = self._p
+        com_pos, com_orn = p.getBasePositionAndOrientation(self.robot)
+        local_pos, local_orn = p.getDynamicsInfo(self.robot, -1)[3:5]
+        inv_pos, inv_orn = p.invertTransform(local_pos, local_orn)
+        pos, orn = p.multiplyTransforms(com_pos, com_orn, inv_pos, inv_orn)
+        return tuple(pos), tuple(orn)
+
     def base_twist(self) -> tuple[float, float]:
         """Ground-truth forward speed (m/s) and yaw rate (rad/s)."""
         lin, ang = self._p.getBaseVelocity(self.robot)
@@ -163,3 +173,16 @@ class World:
         p = self._p
         shape = p.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half_extents)
         return p.createMultiBody(mass, shape, -1, position)
+
+    # --- pictures ----------------------------------------------------------------------------
+    def render(self, width: int, height: int, eye: tuple[float, float, float],
+               target: tuple[float, float, float], fov_deg: float = 45.0) -> np.ndarray:
+        """An RGB picture (height × width × 3, uint8) of the world from `eye` looking at `target`
+        (m, world frame), by PyBullet's CPU renderer: works headless, needs no GPU."""
+        p = self._p
+        view = p.computeViewMatrix(eye, target, [0.0, 0.0, 1.0])
+        projection = p.computeProjectionMatrixFOV(fov_deg, width / height, 0.05, 50.0)
+        _, _, rgba, _, _ = p.getCameraImage(width, height, view, projection, shadow=1,
+                                            lightDirection=[1.0, 1.0, 2.0],
+                                            renderer=pybullet.ER_TINY_RENDERER)
+        return np.asarray(rgba, np.uint8).reshape(height, width, 4)[:, :, :3]
