@@ -39,8 +39,8 @@ class LiveView:
         self.period = 1.0 / rate_hz
         self.log = log
         self.server = viser.ViserServer(host=host, port=port, label="acti_ros2", verbose=False)
-        self.server.initial_camera.position = (2.2, -2.4, 1.8)
-        self.server.initial_camera.look_at = (0.3, 0.0, 0.5)
+        self.server.initial_camera.position = (1.7, -1.8, 1.3)
+        self.server.initial_camera.look_at = (0.2, 0.0, 0.5)
         scene = self.server.scene
         scene.add_grid("/floor", width=10.0, height=10.0, cell_size=0.25, section_size=1.0)
         self.robot = scene.add_frame("/robot", show_axes=False)
@@ -140,12 +140,12 @@ def panel_text(arm: ArmPanel | None, base: BasePanel | None) -> str:
     if arm is not None:
         motion = (f"#{arm.motion_id} {arm.motion_label} {100 * arm.progress:.0f} %"
                   if arm.motion_id else "none")
-        lines += ["**Arm**", "", f"- state: {state_words(arm.state)}",
+        lines += ["#### Arm", f"- state: {state_words(arm.state)}",
                   f"- queued: {arm.queue_length}", f"- motion: {motion}",
                   f"- alarms: {'; '.join(arm.alarms) if arm.alarms else 'none'}", ""]
     if base is not None:
         x, y, th = base.position_mm_deg
-        lines += ["**Base**", "", f"- state: 0x{base.state:03X} {base.state_string}",
+        lines += ["#### Base", f"- state: 0x{base.state:03X} {base.state_string}",
                   f"- position: x {round(x):d} mm, y {round(y):d} mm, θ {round(th, 1) + 0.0:.1f}°",
                   f"- battery: {base.battery_v:.1f} V", f"- queued: {base.queue_length}"]
     return "\n".join(lines)
