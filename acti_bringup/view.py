@@ -2,6 +2,7 @@
 ROS-free `acti_view.live.LiveView` to the cores and the world of the hosted simulation."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from rclpy.node import Node
@@ -34,8 +35,11 @@ class ViewNode(Node):
         if not c.view_enabled:
             self.get_logger().info("live view off (view_enabled:=false)")
             return
-        if not 0 < c.view_port < 65536 or c.view_rate_hz <= 0:
-            raise ValueError("view_port must be 1 … 65535 and view_rate_hz > 0")
+        if not 0 < c.view_port < 65536 or not 0 < c.view_rate_hz < math.inf \
+                or c.view_trail_points < 2:
+            raise ValueError(f"view_port must be 1 … 65535 (is {c.view_port}), view_rate_hz > 0 "
+                             f"and finite (is {c.view_rate_hz}), view_trail_points ≥ 2 "
+                             f"(is {c.view_trail_points})")
         every = max(1, round(simulation.config.rate_hz / c.view_rate_hz))
         reader = Reader(WorldSampler(simulation.executor, every), arm, vehicle)
         self.view = LiveView(reader, {"arm": arm, "base": vehicle}, URDF_PATH, c.view_host,

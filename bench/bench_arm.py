@@ -5,7 +5,7 @@ import math
 import time
 
 import numpy as np
-from common import RosClient, latencies, row, running
+from common import RosClient, latencies, row, running, simulated_arm
 
 from acti_msgs import srv
 from acti_msgs.msg import CarPosWithElbow
@@ -14,6 +14,7 @@ from std_srvs.srv import Trigger
 N = 200
 IDENTITY = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
 ARM = "/acti_middle_node/"
+ARM_START = (0.0, 45.0, 0.0, -90.0, 0.0, 45.0, 0.0)
 
 
 def accept_latency() -> None:
@@ -54,19 +55,11 @@ def accept_latency() -> None:
 
 
 def motion_figures() -> None:
-    from acti_motion.arm.core import ArmConfig, ArmCore
-    from acti_motion.executor import MotionExecutor
     from acti_motion.arm.poses import orientation_error_deg, pose_to_hg, position_error_mm
     from acti_motion.arm.trajectories import (CartesianLimits, ConstAccelTiming, LinePath,
                                           load_toppra, time_optimal)
-    from acti_sim.world import World
 
-    world = World()
-    ex = MotionExecutor(world, real_time_factor=0.0)
-    arm = ArmCore(ex, ArmConfig(initial_joints_deg=(0.0, 45.0, 0.0, -90.0, 0.0, 45.0, 0.0)))
-    arm.servo_on()
-    arm.set_speed_joint(60)
-    arm.set_speed_cartesian(60)
+    world, ex, arm = simulated_arm(ARM_START, 60)
 
     def run(check=None) -> float:
         t0 = world.time

@@ -49,4 +49,33 @@ def row(name: str, sample: np.ndarray, baseline: np.ndarray | None = None) -> st
     return text
 
 
-__all__ = ["RosClient", "running", "latencies", "row"]
+def simulated_arm(initial_joints_deg: tuple[float, ...], speed: int):
+    """(world, executor, arm core) free-running, servo on, both speed ratios at `speed` %."""
+    from acti_motion.arm.core import ArmConfig, ArmCore
+    from acti_motion.executor import MotionExecutor
+    from acti_sim.world import World
+    world = World()
+    executor = MotionExecutor(world, real_time_factor=0.0)
+    arm = ArmCore(executor, ArmConfig(initial_joints_deg=initial_joints_deg))
+    arm.servo_on()
+    arm.set_speed_joint(speed)
+    arm.set_speed_cartesian(speed)
+    return world, executor, arm
+
+
+def simulated_base(velocity: tuple[float, float], acceleration: tuple[float, float]):
+    """(world, executor, vehicle core) free-running, powered, servo on, with these settings."""
+    from acti_motion.executor import MotionExecutor
+    from acti_motion.vehicle.core import VehicleCore
+    from acti_sim.world import World
+    world = World()
+    executor = MotionExecutor(world, real_time_factor=0.0)
+    base = VehicleCore(executor)
+    base.set_power(True)
+    base.set_servo(True)
+    base.set_velocity(velocity)
+    base.set_acceleration(acceleration)
+    return world, executor, base
+
+
+__all__ = ["RosClient", "running", "latencies", "row", "simulated_arm", "simulated_base"]

@@ -21,25 +21,19 @@ import numpy as np  # noqa: E402
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
+from bench_arm import ARM_START  # noqa: E402
 from bench_vehicle_cruise import POINTS_MM, SETTINGS  # noqa: E402
+from common import simulated_arm, simulated_base  # noqa: E402
 
-from acti_motion.arm.core import ArmConfig, ArmCore  # noqa: E402
 from acti_motion.arm.poses import pose_to_hg  # noqa: E402
 from acti_motion.arm.trajectories import CartesianLimits, LinePath, time_optimal  # noqa: E402
-from acti_motion.executor import MotionExecutor  # noqa: E402
-from acti_motion.vehicle.core import VehicleCore  # noqa: E402
 from acti_motion.vehicle.cruise import spline_through  # noqa: E402
 from acti_motion.vehicle.cruise import time_optimal as cruise_bound  # noqa: E402
 from acti_motion.vehicle.paths import Pose2D  # noqa: E402
-from acti_sim.world import World  # noqa: E402
 
 
 def cp_move(out: str) -> None:
-    world = World()
-    ex = MotionExecutor(world, real_time_factor=0.0)
-    arm = ArmCore(ex, ArmConfig(initial_joints_deg=(0.0, 45.0, 0.0, -90.0, 0.0, 45.0, 0.0)))
-    arm.servo_on()
-    arm.set_speed_joint(60)
+    world, ex, arm = simulated_arm(ARM_START, 60)
     arm.set_speed_cartesian(100)
     arm.move_ptp_joint_abs([20, 40, 10, -70, 30, 25, 0])
     while arm.device.busy:
@@ -86,13 +80,7 @@ def cp_move(out: str) -> None:
 
 
 def cruise(out: str) -> None:
-    world = World()
-    ex = MotionExecutor(world, real_time_factor=0.0)
-    base = VehicleCore(ex)
-    base.set_power(True)
-    base.set_servo(True)
-    base.set_velocity(SETTINGS[0])
-    base.set_acceleration(SETTINGS[1])
+    world, ex, base = simulated_base(*SETTINGS)
     for p in POINTS_MM:
         assert base.move_cruise_abs(p).ok
     planned = base.device.queue[0].motion.path
