@@ -4,7 +4,6 @@ view's test and benchmark. Nothing is ever downloaded: both binaries come from a
 from __future__ import annotations
 
 import os
-import socket
 
 import numpy as np
 
@@ -55,9 +54,3 @@ def screenshot(driver, attempts: int = 6) -> np.ndarray:
     rgb = mpimg.imread(io.BytesIO(png), format="png")[:, :, :3]
     return (rgb * 255).astype(np.uint8)
 
-
-def free_port() -> int:
-    """A TCP port on localhost that nothing listens on now."""
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]

@@ -20,7 +20,7 @@ from acti_view.sample import Reader, WorldSampler
 class ViewConfig:
     view_enabled: bool = True         # serve the live 3D view in a browser
     view_host: str = "127.0.0.1"      # address the view listens on (127.0.0.1: this machine only)
-    view_port: int = 8080             # port of the view; the next free one is taken when in use
+    view_port: int = 8080             # port of the view; the next free one when in use; 0: any free one
     view_rate_hz: float = 25.0        # scene updates per second while a page is open [Hz]
     view_trail_points: int = 2000     # points kept in the control-point trail and the odometry path
 
@@ -35,9 +35,9 @@ class ViewNode(Node):
         if not c.view_enabled:
             self.get_logger().info("live view off (view_enabled:=false)")
             return
-        if not 0 < c.view_port < 65536 or not 0 < c.view_rate_hz < math.inf \
+        if not 0 <= c.view_port < 65536 or not 0 < c.view_rate_hz < math.inf \
                 or c.view_trail_points < 2:
-            raise ValueError(f"view_port must be 1 … 65535 (is {c.view_port}), view_rate_hz > 0 "
+            raise ValueError(f"view_port must be 0 … 65535 (is {c.view_port}), view_rate_hz > 0 "
                              f"and finite (is {c.view_rate_hz}), view_trail_points ≥ 2 "
                              f"(is {c.view_trail_points})")
         every = max(1, round(simulation.config.rate_hz / c.view_rate_hz))

@@ -9,6 +9,7 @@ state; buttons from `controls.CONTROLS`.
 from __future__ import annotations
 
 import threading
+import time
 from collections import deque
 from pathlib import Path
 from typing import Any, Callable
@@ -22,6 +23,7 @@ from acti_view.sample import ArmPanel, BasePanel, Reader, ViewSample, state_word
 
 TRAIL_STEP_M = 0.002          # a trail gets a point when the robot moved this far
 PATH_STEP_M = 0.005
+POSE_STEP = 1e-4              # rad, m: a pose that changed less is not sent again
 PANEL_EVERY = 5               # frames between panel refreshes
 ORANGE, BLUE, GREEN, RED = (255, 128, 20), (40, 110, 230), (30, 170, 60), (220, 40, 40)
 
@@ -49,6 +51,7 @@ class LiveView:
         self.frames = 0
         self._panel_text = ""
         self._shown_targets: tuple = ()
+        self._shown_pose: np.ndarray | None = None
         self._build_panel()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._loop, name="acti-view", daemon=True)
@@ -93,7 +96,12 @@ class LiveView:
 
     def _loop(self) -> None:
         failed = False
-        while not self._stop.wait(self.period):
+        deadline = time.monotonic()
+        while True:
+            # a fixed rate, not a fixed pause: the time an update takes is not lost
+            deadline = max(deadline + self.period, time.monotonic() - self.period)
+            if self._stop.wait(max(0.0, deadline - time.monotonic())):
+                return
             if not self.server.get_clients():
                 continue                    # nobody looks: costs nothing
             try:
@@ -112,11 +120,15 @@ class LiveView:
         targets = (tuple(map(tuple, s.arm_targets)), tuple(s.base_targets))
         cfg = np.array([s.world.joints.get(n, 0.0) for n in self._joint_names])
         x, y, z, w = s.world.base_orientation
+        pose = np.concatenate([cfg, s.world.base_position, (w, x, y, z)])
+        posed = self._shown_pose is not None and np.max(np.abs(pose - self._shown_pose)) < POSE_STEP
         scene = self.server.scene
         with self.server.atomic():
-            self.robot.position = s.world.base_position
-            self.robot.wxyz = (w, x, y, z)
-            self.urdf.update_cfg(cfg)
+            if not posed:                  # a robot at rest costs nothing
+                self._shown_pose = pose
+                self.robot.position = s.world.base_position
+                self.robot.wxyz = (w, x, y, z)
+                self.urdf.update_cfg(cfg)
             if trail_grew:
                 _polyline(scene, "/trail/control_point", self.trail, ORANGE)
             if path_grew:

@@ -9,10 +9,10 @@ from acti_msgs import srv
 from acti_msgs.msg import ArmState
 from sensor_msgs.msg import JointState
 
-from acti_bringup.browser import free_port, open_browser, screenshot
+from acti_bringup.browser import open_browser, screenshot
 from ros_harness import node_fixture, wait_until
 
-robot = node_fixture("acti_bringup", f"view_port:={free_port()}")
+robot = node_fixture("acti_bringup", "view_port:=0")
 ARM = "/acti_middle_node/"
 START = [0.0, 30.0, 0.0, -60.0, 0.0, 60.0, 0.0]
 MOVED = [90.0, 60.0, 0.0, -30.0, 0.0, 30.0, 0.0]

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from acti_bringup import snapshot
+from acti_bringup.harness import wait_until
 from acti_motion.arm.core import ArmConfig, ArmCore
 from acti_motion.executor import MotionExecutor
 from acti_motion.vehicle.core import VehicleCore
@@ -94,3 +95,49 @@ def test_snapshot_refuses_joints_outside_the_limits(tmp_path, capsys):
     with pytest.raises(SystemExit):
         snapshot.main([str(tmp_path / "x.png"), "--joints", "500", "0", "0", "0", "0", "0", "0"])
     assert "initial_joints_deg" in capsys.readouterr().err
+
+
+def test_live_view_poses_the_robot_at_its_rate_for_a_connected_page(robot):
+    """A websocket client speaking viser's own messages stands in for the page here (the
+    browser test opens the real one): it says where its camera is, as a page does on connect;
+    the view then updates at its rate, and the poses reach it."""
+    import threading
+    import time
+
+    import msgspec
+    import viser
+    from viser._messages import ViewerCameraMessage
+    from websockets.sync.client import connect
+
+    from acti_sim.world import URDF_PATH
+    from acti_view.live import LiveView
+    executor, arm, base, reader = robot
+    executor.real_time_factor = 1.0
+    executor.start()
+    view = LiveView(reader, {"arm": arm, "base": base}, URDF_PATH, "127.0.0.1", 0, 25.0, 100)
+    view.start()
+    received = []
+    try:
+        url = f"ws://127.0.0.1:{view.server.get_port()}"
+        with connect(url, subprotocols=[f"viser-v{viser.__version__}"]) as ws:
+            def read():
+                try:
+                    while True:
+                        received.append(len(ws.recv()))
+                except Exception:          # closed at the end of the test
+                    pass
+            threading.Thread(target=read, daemon=True).start()
+            camera = ViewerCameraMessage((1.0, 0.0, 0.0, 0.0), (2.0, -2.0, 1.5), 0.8, 0.01, 100.0,
+                                         500, 800, (0.0, 0.0, 0.5), (0.0, 0.0, 1.0))
+            ws.send(msgspec.msgpack.encode(camera.as_serializable_dict()))
+            assert wait_until(lambda: view.frames > 0, 10.0)
+            frames0, t0 = view.frames, time.monotonic()
+            assert wait_until(lambda: view.frames >= frames0 + 50, 10.0)
+            rate = (view.frames - frames0) / (time.monotonic() - t0)
+            count = len(received)
+            assert wait_until(lambda: len(received) > count, 5.0), "no poses reach the page"
+        assert rate >= 20.0, f"{rate:.1f} Hz"
+    finally:
+        view.close()
+        executor.shutdown()
+
