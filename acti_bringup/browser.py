@@ -54,3 +54,18 @@ def screenshot(driver, attempts: int = 6) -> np.ndarray:
     rgb = mpimg.imread(io.BytesIO(png), format="png")[:, :, :3]
     return (rgb * 255).astype(np.uint8)
 
+
+
+def robot_pixels(image: np.ndarray, panel_width: int = 360, top: int = 160) -> np.ndarray:
+    """Mask of the robot's orange links in a screenshot of the view (the GUI panel on the right
+    and the notices at the top cut off)."""
+    view = image[top:, :-panel_width].astype(int)
+    r, g, b = view[..., 0], view[..., 1], view[..., 2]
+    return (r > 140) & (g > 0.3 * r) & (g < 0.75 * r) & (b < 0.45 * r)
+
+
+def dismiss_notices(driver) -> bool:
+    """Close the page's notices (viser tells when WebGL runs in software); whether any was."""
+    return bool(driver.execute_script(
+        "let n = 0; for (const b of document.querySelectorAll('[class*=Notification] button'))"
+        " { b.click(); n++; } return n;"))

@@ -91,7 +91,7 @@ def main() -> None:
         print(f"  {mode:<18} free-running real-time factor {np.median(rtf[mode]):6.2f} "
               f"({np.median(rtf[mode]) / base_rtf:5.2f} of view off)   "
               f"main job CPU at 1x {np.median(cpu[mode]):5.1f} % "
-              f"(+{np.median(cpu[mode]) - base_cpu:4.1f} points)")
+              f"({np.median(cpu[mode]) - base_cpu:+4.1f} points)")
 
 
 if __name__ == "__main__":

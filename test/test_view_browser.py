@@ -9,23 +9,13 @@ from acti_msgs import srv
 from acti_msgs.msg import ArmState
 from sensor_msgs.msg import JointState
 
-from acti_bringup.browser import open_browser, screenshot
+from acti_bringup.browser import open_browser, robot_pixels, screenshot
 from ros_harness import node_fixture, wait_until
 
 robot = node_fixture("acti_bringup", "view_port:=0")
 ARM = "/acti_middle_node/"
 START = [0.0, 30.0, 0.0, -60.0, 0.0, 60.0, 0.0]
 MOVED = [90.0, 60.0, 0.0, -30.0, 0.0, 30.0, 0.0]
-PANEL_WIDTH, TOAST_HEIGHT = 360, 160      # the GUI panel (right) and the notice (top left)
-
-
-def robot_pixels(image: np.ndarray) -> np.ndarray:
-    """Mask of the robot's orange links in the 3D view (panel and notices cut off)."""
-    view = image[TOAST_HEIGHT:, :-PANEL_WIDTH].astype(int)
-    r, g, b = view[..., 0], view[..., 1], view[..., 2]
-    return (r > 140) & (g > 0.3 * r) & (g < 0.75 * r) & (b < 0.45 * r)
-
-
 @pytest.fixture(scope="module")
 def page(robot):
     assert wait_until(lambda: "live view: " in robot.log(), 60.0), robot.log()
