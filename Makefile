@@ -9,7 +9,10 @@ BUILD_STAMP := install/.build-stamp
 COLCON_PATHS := --base-paths . msg_defs
 INTERFACES := $(shell find msg_defs -type f -not -name '*~')
 
-.PHONY: build run test bench clean
+BROWSER := /usr/lib/chromium/chromium-headless-shell /usr/bin/chromedriver
+VIEW_URL := http://127.0.0.1:8080/
+
+.PHONY: build run test bench clean browser
 
 build: $(BUILD_STAMP)
 
@@ -26,16 +29,23 @@ $(BUILD_STAMP): $(DEPS_STAMP) $(INTERFACES) package.xml setup.py setup.cfg tools
 	  --cmake-args -DBUILD_TESTING=OFF -DPython3_EXECUTABLE=$(abspath $(PY))
 	touch $@
 
+# The view's test drives Debian's headless Chromium: installed here when missing, never skipped.
+browser:
+	@for f in $(BROWSER); do test -x $$f || { apt-get update && \
+	  DEBIAN_FRONTEND=noninteractive apt-get install -y chromium-headless-shell chromium-driver; \
+	  break; }; done
+
 run: build
+	@echo "live view: $(VIEW_URL) (the log says so if that port was taken; view_enabled:=false turns it off)"
 	$(ENV) && exec python -m acti_bringup --ros-args --params-file config/acti_ros2.yaml
 
-test: build
+test: build browser
 	$(ENV) && colcon --log-base log test $(COLCON_PATHS) --packages-select acti_ros2 \
 	  --event-handlers console_direct+ --return-code-on-test-failure \
 	  --pytest-args -q -p no:cacheprovider
 	$(ENV) && colcon test-result --test-result-base build/acti_ros2 --verbose
 
-bench: build
+bench: build browser
 	$(ENV) && for b in bench/bench_*.py; do echo "== $$b"; python "$$b" || exit 1; done
 
 clean:

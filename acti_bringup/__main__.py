@@ -1,4 +1,5 @@
-"""The main job: both nodes in one process, sharing one world and one motion-queue executor.
+"""The main job: both nodes in one process, sharing one world and one motion-queue executor,
+and the live browser view of them (node `acti_view`).
 
     python -m acti_bringup [--ros-args ...]
 """
@@ -7,6 +8,7 @@ from __future__ import annotations
 import sys
 
 from acti_bringup.spinning import init
+from acti_bringup.view import ViewNode
 from acti_middle_node.node import ArmNode
 from vehicle_node.node import VehicleNode
 
@@ -15,7 +17,8 @@ def main(args: list[str] | None = None) -> None:
     init(sys.argv if args is None else args)
     arm = ArmNode()
     vehicle = VehicleNode(simulation=arm.simulation)
-    arm.simulation.spin(arm, vehicle)
+    view = ViewNode(arm.simulation, arm.core, vehicle.core)
+    arm.simulation.spin(arm, vehicle, view)
 
 
 if __name__ == "__main__":

@@ -68,11 +68,12 @@ class Simulation:
 
     def spin(self, *nodes: Node) -> None:
         """Run the simulation and serve the nodes until SIGINT/SIGTERM, then clean up: each node
-        on the control plane, its `motion` and `goals` plane nodes on theirs
-        (`acti_bringup.spinning`)."""
+        on the control plane, its `motion` and `goals` plane nodes (a device node has them) on
+        theirs (`acti_bringup.spinning`)."""
         planes = Planes()
         planes.add("control", nodes)
-        helpers = [getattr(n, plane) for plane in ("motion", "goals") for n in nodes]
+        helpers = [getattr(n, plane) for plane in ("motion", "goals") for n in nodes
+                   if hasattr(n, plane)]
         for helper in helpers:
             planes.add(helper.plane, [helper])
         self.executor.start()

@@ -90,13 +90,15 @@ class World:
         self.time += self.time_step
 
     def render(self, eye: tuple[float, float, float], target: tuple[float, float, float],
-               fov_deg: float, width: int, height: int) -> np.ndarray:
+               fov_deg: float, width: int, height: int, shadow: bool = False) -> np.ndarray:
         """An RGB image (height × width × 3, uint8) from a pinhole camera at `eye` looking at
-        `target` (z up), by PyBullet's CPU renderer: some milliseconds, so call it seldom."""
+        `target` (m, z up), by PyBullet's CPU renderer (headless, no GPU): some milliseconds, so
+        call it seldom; `shadow` for pictures meant for people."""
         p = self._p
         view = p.computeViewMatrix(eye, target, [0.0, 0.0, 1.0])
-        projection = p.computeProjectionMatrixFOV(fov_deg, width / height, 0.05, 30.0)
-        rgba = p.getCameraImage(width, height, view, projection,
+        projection = p.computeProjectionMatrixFOV(fov_deg, width / height, 0.05, 50.0)
+        rgba = p.getCameraImage(width, height, view, projection, shadow=int(shadow),
+                                lightDirection=[1.0, 1.0, 2.0],
                                 renderer=pybullet.ER_TINY_RENDERER)[2]
         return np.asarray(rgba, np.uint8).reshape(height, width, 4)[:, :, :3]
 
@@ -168,6 +170,16 @@ class World:
         pos, orn = self._p.getBasePositionAndOrientation(self.robot)
         yaw = self._p.getEulerFromQuaternion(orn)[2]
         return float(pos[0]), float(pos[1]), float(yaw)
+
+    def base_link_pose(self) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+        """Ground-truth position (m) and quaternion (x, y, z, w) of the base_link frame in the
+        world (PyBullet reports the base's inertial frame; its offset is taken out here)."""
+        p = self._p
+        com_pos, com_orn = p.getBasePositionAndOrientation(self.robot)
+        local_pos, local_orn = p.getDynamicsInfo(self.robot, -1)[3:5]
+        inv_pos, inv_orn = p.invertTransform(local_pos, local_orn)
+        pos, orn = p.multiplyTransforms(com_pos, com_orn, inv_pos, inv_orn)
+        return tuple(pos), tuple(orn)
 
     def base_twist(self) -> tuple[float, float]:
         """Ground-truth forward speed (m/s) and yaw rate (rad/s)."""

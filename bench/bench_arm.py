@@ -5,7 +5,7 @@ import math
 import time
 
 import numpy as np
-from common import RosClient, against, bare_call, interleaved, running, table
+from common import RosClient, against, bare_call, interleaved, running, simulated_arm, table
 
 from acti_msgs import srv
 from acti_msgs.msg import CarPosWithElbow
@@ -13,6 +13,7 @@ from acti_msgs.msg import CarPosWithElbow
 N = 200
 IDENTITY = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
 ARM = "/acti_middle_node/"
+ARM_START = (0.0, 45.0, 0.0, -90.0, 0.0, 45.0, 0.0)
 
 
 def accept_latency() -> None:
@@ -50,19 +51,11 @@ def accept_latency() -> None:
 
 
 def motion_figures() -> None:
-    from acti_motion.arm.core import ArmConfig, ArmCore
-    from acti_motion.executor import MotionExecutor
     from acti_motion.arm.poses import orientation_error_deg, pose_to_hg, position_error_mm
     from acti_motion.arm.trajectories import (CartesianLimits, ConstAccelTiming, LinePath,
                                               time_optimal)
-    from acti_sim.world import World
 
-    world = World()
-    ex = MotionExecutor(world, real_time_factor=0.0)
-    arm = ArmCore(ex, ArmConfig(initial_joints_deg=(0.0, 45.0, 0.0, -90.0, 0.0, 45.0, 0.0)))
-    arm.servo_on()
-    arm.set_speed_joint(60)
-    arm.set_speed_cartesian(60)
+    world, ex, arm = simulated_arm(ARM_START, 60)
 
     def run(check=None) -> float:
         t0 = world.time

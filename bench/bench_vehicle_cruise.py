@@ -12,24 +12,17 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
+from common import simulated_base  # noqa: E402
+
 from acti_motion.vehicle.paths import Pose2D  # noqa: E402
 from acti_motion.vehicle.cruise import plan_curve, spline_through, time_optimal  # noqa: E402
-from acti_motion.executor import MotionExecutor  # noqa: E402
-from acti_motion.vehicle.core import VehicleCore  # noqa: E402
-from acti_sim.world import World  # noqa: E402
 
 POINTS_MM = [(1000.0, 0.0), (2000.0, 600.0), (3000.0, 0.0), (4000.0, 600.0), (5000.0, 0.0)]
 SETTINGS = ((800.0, 90.0), (500.0, 180.0))          # velocity, acceleration (mm, degree)
 
 
 def main() -> None:
-    world = World()
-    executor = MotionExecutor(world, real_time_factor=0.0)
-    base = VehicleCore(executor)
-    base.set_power(True)
-    base.set_servo(True)
-    base.set_velocity(SETTINGS[0])
-    base.set_acceleration(SETTINGS[1])
+    world, executor, base = simulated_base(*SETTINGS)
     wall = []
     for p in POINTS_MM:
         t0 = time.perf_counter()

@@ -121,6 +121,34 @@ def worst_ratios(samples: dict[str, np.ndarray], baseline: str) -> tuple[float, 
     return (max(p(s, 50) for s in rest) / p(base, 50), max(p(s, 99) for s in rest) / p(base, 99))
 
 
+def simulated_arm(initial_joints_deg: tuple[float, ...], speed: int):
+    """(world, executor, arm core) free-running, servo on, both speed ratios at `speed` %."""
+    from acti_motion.arm.core import ArmConfig, ArmCore
+    from acti_motion.executor import MotionExecutor
+    from acti_sim.world import World
+    world = World()
+    executor = MotionExecutor(world, real_time_factor=0.0)
+    arm = ArmCore(executor, ArmConfig(initial_joints_deg=initial_joints_deg))
+    arm.servo_on()
+    arm.set_speed_joint(speed)
+    arm.set_speed_cartesian(speed)
+    return world, executor, arm
+
+
+def simulated_base(velocity: tuple[float, float], acceleration: tuple[float, float]):
+    """(world, executor, vehicle core) free-running, powered, servo on, with these settings."""
+    from acti_motion.executor import MotionExecutor
+    from acti_motion.vehicle.core import VehicleCore
+    from acti_sim.world import World
+    world = World()
+    executor = MotionExecutor(world, real_time_factor=0.0)
+    base = VehicleCore(executor)
+    base.set_power(True)
+    base.set_servo(True)
+    base.set_velocity(velocity)
+    base.set_acceleration(acceleration)
+    return world, executor, base
+
+
 __all__ = ["Actions", "RosClient", "running", "bare_call", "interleaved", "latencies", "against",
-           "row", "table", "p",
-           "worst_ratios", "idle_cpu_percent"]
+           "row", "table", "p", "worst_ratios", "idle_cpu_percent", "simulated_arm", "simulated_base"]

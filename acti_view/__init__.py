@@ -1,0 +1,1 @@
+"""ROS-free pictures of the running robot: the live browser view (viser), the PNG snapshot."""
