@@ -15,10 +15,13 @@ CALL_TIMEOUT = 30.0
 
 
 class NodeProcess:
-    """`python -m <module>` with --ros-args; stopped by PID (SIGINT, then SIGKILL)."""
+    """`python -m <module>` with --ros-args (parameters `name:=value`, and a namespace for one
+    robot of a fleet); stopped by PID (SIGINT, then SIGKILL)."""
 
-    def __init__(self, module: str, log_path: str, *params: str) -> None:
+    def __init__(self, module: str, log_path: str, *params: str, namespace: str = "") -> None:
         args = [sys.executable, "-m", module, "--ros-args"]
+        if namespace:
+            args += ["-r", f"__ns:={namespace}"]
         for p in params:
             args += ["-p", p]
         self.log_path = log_path

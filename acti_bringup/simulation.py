@@ -1,14 +1,19 @@
 """The simulation a process hosts: one PyBullet world and one motion-queue executor, with the
-topics that belong to the world as a whole (/clock and joint_states)."""
+topics that belong to the world as a whole (clock and joint_states).
+
+Both topics are relative, so each robot of a fleet (`-r __ns:=/robotN`) publishes its own world's
+time and joints in its namespace: /robotN/clock, /robotN/joint_states (/clock alone)."""
 from __future__ import annotations
 
 import sys
 from dataclasses import dataclass
+from typing import Callable
 
 import rclpy
 from builtin_interfaces.msg import Time
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node
+from rclpy.publisher import Publisher
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
@@ -24,6 +29,8 @@ class SimulationConfig:
     rate_hz: float = 240.0
     real_time_factor: float = 1.0
     joint_state_rate_hz: float = 50.0
+    # rate of the simulated time on `clock` (/clock, or /<namespace>/clock) [Hz]; 0: not published
+    clock_rate_hz: float = 100.0
 
 
 def stamp(node_time: float) -> Time:
@@ -39,15 +46,27 @@ class Simulation:
         # Service threads wait for the GIL while the simulation thread computes; a short switch
         # interval bounds that wait (the default 5 ms would dominate every round trip).
         sys.setswitchinterval(SWITCH_INTERVAL_S)
-        if c.rate_hz <= 0 or c.real_time_factor < 0 or c.joint_state_rate_hz <= 0:
-            raise ValueError("rate_hz and joint_state_rate_hz must be > 0, real_time_factor >= 0")
+        if c.rate_hz <= 0 or c.real_time_factor < 0 or c.joint_state_rate_hz <= 0 \
+                or c.clock_rate_hz < 0:
+            raise ValueError("rate_hz and joint_state_rate_hz must be > 0, real_time_factor and "
+                             "clock_rate_hz >= 0")
         self.world = World(time_step=1.0 / c.rate_hz)
         self.executor = MotionExecutor(self.world, c.real_time_factor, alive=node.context.ok)
-        self._clock = node.create_publisher(Clock, "/clock", 10)
+        if c.clock_rate_hz > 0:
+            self._clock = node.create_publisher(Clock, "clock", 10)
+            self.publish_at(c.clock_rate_hz, self._publish_clock, self._clock)
         self._joints = node.create_publisher(JointState, "joint_states", 10)
-        self.executor.after_step(self._publish_clock)
-        self.executor.after_step(self._publish_joint_states,
-                                 every=max(1, round(c.rate_hz / c.joint_state_rate_hz)))
+        self.publish_at(c.joint_state_rate_hz, self._publish_joint_states, self._joints)
+
+    def publish_at(self, rate_hz: float, publish: Callable[[World], None],
+                   *publishers: Publisher) -> None:
+        """Run publish(world) on the simulation thread at about rate_hz while one of `publishers`
+        has a subscriber. Building messages nobody receives was most of an idle robot's Python
+        work; a volatile topic without subscribers shows nothing, so skipping it changes nothing."""
+        def listened(world: World) -> None:
+            if any(p.get_subscription_count() for p in publishers):
+                publish(world)
+        self.executor.after_step(listened, every=self.executor.steps_per_period(rate_hz))
 
     def now(self) -> Time:
         return stamp(self.world.time)
