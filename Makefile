@@ -5,9 +5,21 @@ VENV := .venv
 PY := $(VENV)/bin/python
 ENV := source tools/env.sh
 DEPS_STAMP := $(VENV)/.deps-stamp
-BUILD_STAMP := install/.build-stamp
+BUILD_STAMP = install/.build-stamp-cpp-$(ACTI_MSGS_CPP)
 COLCON_PATHS := --base-paths . msg_defs
 INTERFACES := $(shell find msg_defs -type f -not -name '*~')
+# The interface packages are built for Python only (see msg_defs/CMakeLists.txt); ON adds the C++
+# headers and type supports that C++ code linking against acti_msgs needs (`make build
+# ACTI_MSGS_CPP=ON`; the stamp names the choice, so switching rebuilds).
+ACTI_MSGS_CPP ?= OFF
+NPROC := $(shell nproc)
+# Every core for make (colcon's default -l also stops new jobs while the machine is busy), one
+# package per core, and ccache (from requirements.txt) keeping compiled objects between builds
+# and clones: paths relative to the checkout, so another clone hits the same entries.
+BUILD_ENV := MAKEFLAGS=-j$(NPROC) CCACHE_BASEDIR=$(CURDIR) CCACHE_NOHASHDIR=true
+CMAKE_ARGS := -DBUILD_TESTING=OFF -DPython3_EXECUTABLE=$(abspath $(PY)) \
+  -DACTI_MSGS_CPP=$(ACTI_MSGS_CPP) -DCMAKE_C_COMPILER_LAUNCHER=ccache \
+  -DCMAKE_CXX_COMPILER_LAUNCHER=ccache
 
 .PHONY: build run test bench clean
 
@@ -21,8 +33,8 @@ $(DEPS_STAMP): requirements.txt requirements.lock tools/fix_cmake_paths.py
 
 # Python sources need no rebuild: --symlink-install runs them from the tree.
 $(BUILD_STAMP): $(DEPS_STAMP) $(INTERFACES) package.xml setup.py setup.cfg
-	$(ENV) && colcon --log-base log build $(COLCON_PATHS) --symlink-install \
-	  --cmake-args -DBUILD_TESTING=OFF -DPython3_EXECUTABLE=$(abspath $(PY))
+	$(ENV) && $(BUILD_ENV) colcon --log-base log build $(COLCON_PATHS) --symlink-install \
+	  --parallel-workers $(NPROC) --cmake-args $(CMAKE_ARGS)
 	touch $@
 
 run: build
