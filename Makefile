@@ -25,9 +25,18 @@ CMAKE_ARGS := -DBUILD_TESTING=OFF -DPython3_EXECUTABLE=$(abspath $(PY)) \
 
 build: $(BUILD_STAMP)
 
+# pip's HTTP cache keeps nothing from this registry, so the wheels are kept in a wheelhouse: a new
+# venv (another clone, `rm -r .venv`) installs from it without the network; the lock pins every
+# wheel. A requirement it lacks sends pip to the registry for the missing ones.
+WHEELHOUSE ?= $(HOME)/.cache/acti_ros2/wheels
+PIP := $(PY) -m pip --disable-pip-version-check
+REQUIREMENTS := -r requirements.txt -c requirements.lock
+
 $(DEPS_STAMP): requirements.txt requirements.lock tools/fix_cmake_paths.py
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --disable-pip-version-check -r requirements.txt -c requirements.lock
+	$(PIP) install --quiet --no-index --find-links $(WHEELHOUSE) $(REQUIREMENTS) 2>/dev/null || { \
+	  $(PIP) wheel --quiet --find-links $(WHEELHOUSE) -w $(WHEELHOUSE) $(REQUIREMENTS) && \
+	  $(PIP) install --quiet --no-index --find-links $(WHEELHOUSE) $(REQUIREMENTS); }
 	$(PY) tools/fix_cmake_paths.py $(VENV)
 	touch $@
 
