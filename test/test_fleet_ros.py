@@ -1,7 +1,9 @@
 """A fleet in one domain: two main jobs in namespaces /robot1 and /robot2, each moved over DDS
-without touching the other, each publishing its own simulated time in its namespace."""
+without touching the other, each publishing its own simulated time and joints in its namespace
+(published only while subscribed: these subscriptions start them)."""
 from acti_msgs import srv
 from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
 
 from ros_harness import node_fixture, wait_until
 
@@ -53,16 +55,24 @@ def test_each_robot_moves_without_touching_the_other(ros, robot1, robot2):
     assert (r.state, r.msg) == (0x019, "Unpowered")
 
 
-def test_each_robot_publishes_its_own_clock_in_its_namespace(ros, robot1, robot2):
-    got: dict[str, list[float]] = {"/robot1": [], "/robot2": []}
-    subs = [ros.node.create_subscription(
-        Clock, f"{ns}/clock", lambda m, ns=ns: got[ns].append(m.clock.sec + m.clock.nanosec * 1e-9),
-        10) for ns in got]
+STAMPED = {"clock": (Clock, lambda m: m.clock), "joint_states": (JointState, lambda m: m.header.stamp)}
+
+
+def test_each_robot_publishes_its_own_clock_and_joints_in_its_namespace(ros, robot1, robot2):
+    got: dict[str, list[float]] = {}
+    subs = []
+    for ns in ("/robot1", "/robot2"):
+        for topic, (msg_type, stamp_of) in STAMPED.items():
+            times = got[f"{ns}/{topic}"] = []
+            subs.append(ros.node.create_subscription(
+                msg_type, f"{ns}/{topic}", lambda m, times=times, stamp_of=stamp_of:
+                times.append(stamp_of(m).sec + stamp_of(m).nanosec * 1e-9), 10))
     try:
         assert ros.spin_until(lambda: all(len(t) >= 20 for t in got.values()), 30.0)
-        for times in got.values():
-            assert times == sorted(times) and times[-1] > times[0]
+        for stamps in got.values():
+            assert stamps == sorted(stamps) and stamps[-1] > stamps[0]
         assert ros.node.count_publishers("/clock") == 0
+        assert ros.node.count_publishers("/joint_states") == 0
     finally:
         for s in subs:
             ros.node.destroy_subscription(s)
