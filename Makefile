@@ -5,9 +5,21 @@ VENV := .venv
 PY := $(VENV)/bin/python
 ENV := source tools/env.sh
 DEPS_STAMP := $(VENV)/.deps-stamp
-BUILD_STAMP := install/.build-stamp
+BUILD_STAMP = install/.build-stamp-cpp-$(ACTI_MSGS_CPP)
 COLCON_PATHS := --base-paths . msg_defs
 INTERFACES := $(shell find msg_defs -type f -not -name '*~')
+# The interface packages are built for Python only (see msg_defs/CMakeLists.txt); ON adds the C++
+# headers and type supports that C++ code linking against acti_msgs needs (`make build
+# ACTI_MSGS_CPP=ON`; the stamp names the choice, so switching rebuilds).
+ACTI_MSGS_CPP ?= OFF
+NPROC := $(shell nproc)
+# Every core for make (colcon's default -l also stops new jobs while the machine is busy), one
+# package per core, and ccache (from requirements.txt) keeping compiled objects between builds
+# and clones: paths relative to the checkout, so another clone hits the same entries.
+BUILD_ENV := MAKEFLAGS=-j$(NPROC) CCACHE_BASEDIR=$(CURDIR) CCACHE_NOHASHDIR=true
+CMAKE_ARGS := -DBUILD_TESTING=OFF -DPython3_EXECUTABLE=$(abspath $(PY)) \
+  -DACTI_MSGS_CPP=$(ACTI_MSGS_CPP) -DCMAKE_C_COMPILER_LAUNCHER=ccache \
+  -DCMAKE_CXX_COMPILER_LAUNCHER=ccache
 
 BROWSER := /usr/lib/chromium/chromium-headless-shell /usr/bin/chromedriver
 VIEW_URL := http://127.0.0.1:8080/
@@ -16,17 +28,26 @@ VIEW_URL := http://127.0.0.1:8080/
 
 build: $(BUILD_STAMP)
 
+# pip's HTTP cache keeps nothing from this registry, so the wheels are kept in a wheelhouse: a new
+# venv (another clone, `rm -r .venv`) installs from it without the network; the lock pins every
+# wheel. A requirement it lacks sends pip to the registry for the missing ones.
+WHEELHOUSE ?= $(HOME)/.cache/acti_ros2/wheels
+PIP := $(PY) -m pip --disable-pip-version-check
+REQUIREMENTS := -r requirements.txt -c requirements.lock
+
 $(DEPS_STAMP): requirements.txt requirements.lock tools/fix_cmake_paths.py
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --disable-pip-version-check -r requirements.txt -c requirements.lock
+	$(PIP) install --quiet --no-index --find-links $(WHEELHOUSE) $(REQUIREMENTS) 2>/dev/null || { \
+	  $(PIP) wheel --quiet --find-links $(WHEELHOUSE) -w $(WHEELHOUSE) $(REQUIREMENTS) && \
+	  $(PIP) install --quiet --no-index --find-links $(WHEELHOUSE) $(REQUIREMENTS); }
 	$(PY) tools/fix_cmake_paths.py $(VENV)
 	touch $@
 
 # Python sources need no rebuild: --symlink-install runs them from the tree. Our tf2_msgs
 # (msg_defs/tf2_msgs) is added only where no tf2_msgs is installed (tools/own_tf2_msgs.py).
 $(BUILD_STAMP): $(DEPS_STAMP) $(INTERFACES) package.xml setup.py setup.cfg tools/own_tf2_msgs.py
-	$(ENV) && colcon --log-base log build $(COLCON_PATHS) $$(python tools/own_tf2_msgs.py) --symlink-install \
-	  --cmake-args -DBUILD_TESTING=OFF -DPython3_EXECUTABLE=$(abspath $(PY))
+	$(ENV) && $(BUILD_ENV) colcon --log-base log build $(COLCON_PATHS) $$(python tools/own_tf2_msgs.py) \
+	  --symlink-install --parallel-workers $(NPROC) --cmake-args $(CMAKE_ARGS)
 	touch $@
 
 # The view's test drives Debian's headless Chromium: installed here when missing, never skipped.

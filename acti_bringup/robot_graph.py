@@ -15,7 +15,6 @@ from tf2_msgs.msg import TFMessage
 from acti_bringup.parameters import declare_config
 from acti_bringup.transforms import LATCHED_QOS, link_transform, static_tf_publisher, tf_publisher
 from acti_motion.link_poses import LinkPoses, LinkTransform
-from acti_motion.executor import MotionExecutor
 from acti_sim.world import World
 
 
@@ -27,11 +26,12 @@ class RobotGraphConfig:
 class RobotGraph:
     """robot_description and the links' TF of one hosted simulation."""
 
-    def __init__(self, node: Node, executor: MotionExecutor, every: int,
-                 now: Callable[[], Any]) -> None:
+    def __init__(self, node: Node, urdf_path: str, rate_hz: float, now: Callable[[], Any],
+                 publish_at: Callable[..., None]) -> None:
+        """Links on the TF at `rate_hz` by `publish_at` (`Simulation.publish_at`: on the
+        simulation thread, while anybody listens)."""
         self.config = declare_config(node, RobotGraphConfig)
         self._now = now
-        urdf_path = executor.world.urdf_path
         with open(urdf_path) as f:
             urdf = f.read()
         self._description = node.create_publisher(String, "robot_description", LATCHED_QOS)
@@ -49,7 +49,7 @@ class RobotGraph:
             link_transform(stamp, LinkTransform(j.parent, j.child, (0.0, 0.0, 0.0),
                                                 (0.0, 0.0, 0.0, 1.0)))
             for j in self.links.movable])
-        executor.after_step(self._publish_links, every=every)
+        publish_at(rate_hz, self._publish_links, self._tf)
 
     def _publish_links(self, world: World) -> None:
         names, positions, _ = world.joint_states()

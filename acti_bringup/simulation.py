@@ -1,14 +1,20 @@
 """The simulation a process hosts: one PyBullet world and one motion-queue executor, with the
-topics that belong to the world as a whole (/clock, joint_states, robot_description, the links'
-TF and the camera)."""
+topics that belong to the world as a whole (clock, joint_states, robot_description, the links'
+TF and the camera).
+
+Every topic is relative, so each robot of a fleet (`-r __ns:=/robotN`) publishes its own world's
+time, joints and transforms in its namespace: /robotN/clock, /robotN/joint_states, /robotN/tf …
+(/clock, /tf … alone)."""
 from __future__ import annotations
 
 import sys
 from dataclasses import dataclass
+from typing import Callable
 
 import rclpy
 from builtin_interfaces.msg import Time
 from rclpy.node import Node
+from rclpy.publisher import Publisher
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
@@ -26,7 +32,9 @@ SWITCH_INTERVAL_S = 2e-4
 class SimulationConfig:
     rate_hz: float = 250.0              # physics and control rate [Hz] (250: a 4 ms cycle)
     real_time_factor: float = 1.0       # simulated seconds per wall second (0: as fast as it can)
-    joint_state_rate_hz: float = 50.0   # joint_states publication rate [Hz]
+    joint_state_rate_hz: float = 50.0   # joint_states (and the links' TF) publication rate [Hz]
+    # rate of the simulated time on `clock` (/clock, or /<namespace>/clock) [Hz]; 0: not published
+    clock_rate_hz: float = 100.0
 
 
 def stamp(node_time: float) -> Time:
@@ -42,17 +50,30 @@ class Simulation:
         # Service threads wait for the GIL while the simulation thread computes; a short switch
         # interval bounds that wait (the default 5 ms would dominate every round trip).
         sys.setswitchinterval(SWITCH_INTERVAL_S)
-        if c.rate_hz <= 0 or c.real_time_factor < 0 or c.joint_state_rate_hz <= 0:
-            raise ValueError("rate_hz and joint_state_rate_hz must be > 0, real_time_factor >= 0")
+        if c.rate_hz <= 0 or c.real_time_factor < 0 or c.joint_state_rate_hz <= 0 \
+                or c.clock_rate_hz < 0:
+            raise ValueError("rate_hz and joint_state_rate_hz must be > 0, real_time_factor and "
+                             "clock_rate_hz >= 0")
         self.world = World(time_step=1.0 / c.rate_hz)
         self.executor = MotionExecutor(self.world, c.real_time_factor, alive=node.context.ok)
-        self._clock = node.create_publisher(Clock, "/clock", 10)
+        if c.clock_rate_hz > 0:
+            self._clock = node.create_publisher(Clock, "clock", 10)
+            self.publish_at(c.clock_rate_hz, self._publish_clock, self._clock)
         self._joints = node.create_publisher(JointState, "joint_states", 10)
-        self.executor.after_step(self._publish_clock)
-        joint_state_every = max(1, round(c.rate_hz / c.joint_state_rate_hz))
-        self.executor.after_step(self._publish_joint_states, every=joint_state_every)
-        self.graph = RobotGraph(node, self.executor, joint_state_every, self.now)
+        self.publish_at(c.joint_state_rate_hz, self._publish_joint_states, self._joints)
+        self.graph = RobotGraph(node, self.world.urdf_path, c.joint_state_rate_hz, self.now,
+                                self.publish_at)
         self.camera = SimCamera(node, self.executor, self.now)
+
+    def publish_at(self, rate_hz: float, publish: Callable[[World], None],
+                   *publishers: Publisher) -> None:
+        """Run publish(world) on the simulation thread at about rate_hz while one of `publishers`
+        has a subscriber. Building messages nobody receives was most of an idle robot's Python
+        work; a volatile topic without subscribers shows nothing, so skipping it changes nothing."""
+        def listened(world: World) -> None:
+            if any(p.get_subscription_count() for p in publishers):
+                publish(world)
+        self.executor.after_step(listened, every=self.executor.steps_per_period(rate_hz))
 
     def now(self) -> Time:
         return stamp(self.world.time)

@@ -17,12 +17,12 @@ LATCHED_QOS = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
 
 def tf_publisher(node: Node) -> Any:
-    return node.create_publisher(TFMessage, "/tf", TF_QOS)
+    return node.create_publisher(TFMessage, "tf", TF_QOS)
 
 
 def static_tf_publisher(node: Node) -> Any:
-    """/tf_static: latched, so listeners that start later still get every static transform."""
-    return node.create_publisher(TFMessage, "/tf_static", LATCHED_QOS)
+    """tf_static: latched, so listeners that start later still get every static transform."""
+    return node.create_publisher(TFMessage, "tf_static", LATCHED_QOS)
 
 
 def link_transform(stamp: Any, t: LinkTransform) -> TransformStamped:

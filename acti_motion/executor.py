@@ -408,6 +408,10 @@ class MotionExecutor:
         """Run fn(world) on the simulation thread after every `every`-th physics step."""
         self._after.append((max(1, every), fn))
 
+    def steps_per_period(self, rate_hz: float) -> int:
+        """The `every` of a listener that runs at about rate_hz (at most once a step)."""
+        return max(1, round(1.0 / (rate_hz * self.dt)))
+
     def step(self) -> None:
         """One control cycle: listeners, devices, physics. Used by the thread and by unit tests."""
         world = self.world

@@ -17,12 +17,13 @@ def ros() -> RosClient:
     client.close()
 
 
-def node_fixture(module: str, *params: str):
-    """A module-scoped fixture running one node process (4× real time) for the tests of a file."""
+def node_fixture(module: str, *params: str, namespace: str = ""):
+    """A module-scoped fixture running one node process (4× real time) for the tests of a file,
+    in `namespace` when given (one robot of a fleet)."""
     @pytest.fixture(scope="module")
     def fixture(tmp_path_factory):
         log = str(tmp_path_factory.mktemp(module) / "node.log")
-        node = NodeProcess(module, log, TEST_RATE, *params)
+        node = NodeProcess(module, log, TEST_RATE, *params, namespace=namespace)
         yield node
         alive = node.alive()
         code = node.stop()

@@ -111,11 +111,11 @@ class VehicleNode(Node):
         # commands that move the base arrive on the motion plane, like the move services
         self.motion.create_subscription(Twist, "cmd_vel", self._on_cmd_vel, 10)
         self.motion.create_subscription(Joy, "joy", self._on_joy, 10)
-        rate = self.simulation.config.rate_hz
-        ex = self.simulation.executor
-        ex.after_step(self._publish_odometry, every=max(1, round(rate / ODOM_RATE_HZ)))
-        ex.after_step(self._publish_state, every=max(1, round(rate / STATE_RATE_HZ)))
-        ex.after_step(self._publish_diagnostics, every=max(1, round(rate / DIAGNOSTICS_RATE_HZ)))
+        sim = self.simulation
+        odometry_out = [p for p in (self._odom, self._truth, self._tf) if p is not None]
+        sim.publish_at(ODOM_RATE_HZ, self._publish_odometry, *odometry_out)
+        sim.publish_at(STATE_RATE_HZ, self._publish_state, self._state)
+        sim.publish_at(DIAGNOSTICS_RATE_HZ, self._publish_diagnostics, self._diagnostics)
 
     # --- topics in ---------------------------------------------------------------------------
     def _on_cmd_vel(self, msg: Twist) -> None:

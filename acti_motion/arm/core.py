@@ -243,26 +243,26 @@ class ArmCore:
 
     def _watch(self) -> None:
         """Stop and raise an alarm when the commanded set-point leaves a soft limit while moving
-        (possible when the limits changed after the motion was accepted)."""
+        (possible when the limits changed after the motion was accepted).
+
+        At rest nothing is computed (the FK is most of a step's Python work): the first moving
+        step compares against the rest point, under the limits in force then."""
         d = self.device
         cur = d.current
-        q = cur.motion.at(d.t).joints if cur is not None else d.hold.joints
-        qd = np.degrees(q)
-        p = self.frames.tool_of(self.kin.flange(q))[:3, 3] * 1000.0
-        values = np.concatenate([qd, p])
-        lj, lc = self.soft_limit_joint, self.soft_limit_cartesian
-        lower = np.concatenate([lj[:, 0] - JOINT_WATCH_TOLERANCE_DEG,
-                                lc[:, 0] - CARTESIAN_WATCH_TOLERANCE_MM])
-        upper = np.concatenate([lj[:, 1] + JOINT_WATCH_TOLERANCE_DEG,
-                                lc[:, 1] + CARTESIAN_WATCH_TOLERANCE_MM])
-        inside = (values >= lower) & (values <= upper)
+        if cur is None:
+            self._inside = None
+            return
+        if self._inside is None:
+            self._inside = self._within_watch_limits(d.hold.joints)[1]
+        values, inside = self._within_watch_limits(cur.motion.at(d.t).joints)
         was, self._inside = self._inside, inside
-        if cur is None or was is None or self._alarms:
+        if self._alarms:
             return
         left = np.flatnonzero(was & ~inside)
         if not len(left):
             return
         i = int(left[0])
+        lj, lc = self.soft_limit_joint, self.soft_limit_cartesian
         if i < self.axis_count:
             alarm = Alarm(ALARM_JOINT_SOFT_LIMIT, AlarmType.WARNING,
                           f"joint soft limit exceeded while moving: J{i + 1} = {values[i]:.3f}° "
@@ -276,6 +276,18 @@ class ArmCore:
         with self._alarm_lock:
             self._alarms.append(alarm)
         self.stop_motion(fastest=True)
+
+    def _within_watch_limits(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Joint values (degree) and control-point position (mm) of set-point q, and which of
+        them lie within the soft limits widened by the watch tolerances."""
+        p = self.frames.tool_of(self.kin.flange(q))[:3, 3] * 1000.0
+        values = np.concatenate([np.degrees(q), p])
+        lj, lc = self.soft_limit_joint, self.soft_limit_cartesian
+        lower = np.concatenate([lj[:, 0] - JOINT_WATCH_TOLERANCE_DEG,
+                                lc[:, 0] - CARTESIAN_WATCH_TOLERANCE_MM])
+        upper = np.concatenate([lj[:, 1] + JOINT_WATCH_TOLERANCE_DEG,
+                                lc[:, 1] + CARTESIAN_WATCH_TOLERANCE_MM])
+        return values, (values >= lower) & (values <= upper)
 
     # === common port ============================================================================
     @returns(R.STATUS_ERR)

@@ -1,0 +1,78 @@
+"""A fleet in one domain: two main jobs in namespaces /robot1 and /robot2, each moved over DDS
+without touching the other, each publishing its own simulated time and joints in its namespace
+(published only while subscribed: these subscriptions start them)."""
+from acti_msgs import srv
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+
+from ros_harness import node_fixture, wait_until
+
+robot1 = node_fixture("acti_bringup", namespace="/robot1")
+robot2 = node_fixture("acti_bringup", namespace="/robot2")
+
+TARGET = [15.0, 25.0, -10.0, -70.0, 20.0, 45.0, -30.0]
+
+
+def arm(ns: str, op: str) -> str:
+    return f"{ns}/acti_middle_node/{op}"
+
+
+def base(ns: str, op: str) -> str:
+    return f"{ns}/vehicle_node/{op}"
+
+
+def joints(ros, ns):
+    return ros.call(srv.GetFeedbackPosJoint, arm(ns, "get_feedback_pos_joint")).pos
+
+
+def position(ros, ns):
+    p = ros.call(srv.VehicleGetPosition, base(ns, "get_position")).pos
+    return p.x, p.y, p.theta
+
+
+def test_each_robot_moves_without_touching_the_other(ros, robot1, robot2):
+    joints2, pos1 = joints(ros, "/robot2"), position(ros, "/robot1")
+    assert ros.call(srv.ServoON, arm("/robot1", "servo_on")).return_id.id == 0
+    assert ros.call(srv.SetSpeedJoint, arm("/robot1", "set_speed_joint"),
+                    spd_ratio=60).return_id.id == 0
+    assert ros.call(srv.MovePTPJointAbs, arm("/robot1", "move_ptp_joint_abs"),
+                    joint_points=TARGET).return_id.id == 0
+    assert ros.call(srv.VehicleSetPower, base("/robot2", "set_power"), on_off=True).success
+    assert ros.call(srv.VehicleSetServo, base("/robot2", "set_servo"), on_off=True).success
+    assert ros.call(srv.VehicleMoveForward, base("/robot2", "move_forward"), x=300.0).success
+
+    assert wait_until(lambda: ros.call(srv.GetState, arm("/robot1", "get_state")).state & 0x02 == 0
+                      and ros.call(srv.VehicleGetState, base("/robot2", "get_state")).state == 0x010,
+                      30.0)
+    assert max(abs(a - b) for a, b in zip(joints(ros, "/robot1"), TARGET)) < 0.01
+    x, y, _ = position(ros, "/robot2")
+    assert abs(x - 300.0) < 5.0 and abs(y) < 5.0
+    # the other robot of each pair did not move and was not switched on
+    assert max(abs(a - b) for a, b in zip(joints(ros, "/robot2"), joints2)) < 0.01
+    assert max(abs(a - b) for a, b in zip(position(ros, "/robot1"), pos1)) < 0.5
+    assert ros.call(srv.GetState, arm("/robot2", "get_state")).state & 0x01 == 0      # servo off
+    r = ros.call(srv.VehicleGetState, base("/robot1", "get_state"))
+    assert (r.state, r.msg) == (0x019, "Unpowered")
+
+
+STAMPED = {"clock": (Clock, lambda m: m.clock), "joint_states": (JointState, lambda m: m.header.stamp)}
+
+
+def test_each_robot_publishes_its_own_clock_and_joints_in_its_namespace(ros, robot1, robot2):
+    got: dict[str, list[float]] = {}
+    subs = []
+    for ns in ("/robot1", "/robot2"):
+        for topic, (msg_type, stamp_of) in STAMPED.items():
+            times = got[f"{ns}/{topic}"] = []
+            subs.append(ros.node.create_subscription(
+                msg_type, f"{ns}/{topic}", lambda m, times=times, stamp_of=stamp_of:
+                times.append(stamp_of(m).sec + stamp_of(m).nanosec * 1e-9), 10))
+    try:
+        assert ros.spin_until(lambda: all(len(t) >= 20 for t in got.values()), 30.0)
+        for stamps in got.values():
+            assert stamps == sorted(stamps) and stamps[-1] > stamps[0]
+        assert ros.node.count_publishers("/clock") == 0
+        assert ros.node.count_publishers("/joint_states") == 0
+    finally:
+        for s in subs:
+            ros.node.destroy_subscription(s)
