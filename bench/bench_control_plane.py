@@ -290,8 +290,9 @@ def ms(x: float) -> str:
 
 def main() -> None:
     ros = RosClient(call_timeout=5.0)
+    # /clock on every control step (clock_rate_hz = rate_hz), so its gaps show every stall
     params = (f"max_action_goals:={MAX_GOALS}", f"max_wait_goals:={MAX_GOALS}",
-              f"queue_size:={QUEUE}")
+              f"queue_size:={QUEUE}", "rate_hz:=250.0", "clock_rate_hz:=250.0")
     with running("bench.trigger_server"), running("acti_bringup", *params):
         bg = Background()
         prepare(ros)

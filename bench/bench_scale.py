@@ -140,7 +140,11 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as log_dir:
         try:
             for n in range(1, args.max + 1):
-                robots.append(start(ros, n, args.rate, log_dir))
+                try:
+                    robots.append(start(ros, n, args.rate, log_dir))
+                except TimeoutError as e:        # the machine is full: this one never came up
+                    print(f"robot {n} did not start: {e}", flush=True)
+                    break
                 wait_until(lambda: all(at_rest(ros, r) for r in robots), 30.0)
                 idle = measure(ros, robots, args.window)
                 print(summary("idle", n, idle), flush=True)

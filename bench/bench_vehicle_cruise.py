@@ -14,7 +14,10 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from common import simulated_base  # noqa: E402
 
+from acti_motion.executor import MotionExecutor  # noqa: E402
+from acti_motion.vehicle.core import VehicleCore  # noqa: E402
 from acti_motion.vehicle.paths import Pose2D  # noqa: E402
+from acti_sim.world import World  # noqa: E402
 from acti_motion.vehicle.cruise import plan_curve, spline_through, time_optimal  # noqa: E402
 
 POINTS_MM = [(1000.0, 0.0), (2000.0, 600.0), (3000.0, 0.0), (4000.0, 600.0), (5000.0, 0.0)]
@@ -67,10 +70,7 @@ def main() -> None:
 
 def adding_points(n: int) -> None:
     """Wall time of each of n move_cruise_abs calls on a queued cruise (a zig-zag, 0.4 m apart)."""
-    world = World()
-    base = VehicleCore(MotionExecutor(world, real_time_factor=0.0))
-    base.set_power(True)
-    base.set_servo(True)
+    world, _, base = simulated_base()
     wall = []
     for i in range(n):
         t0 = time.perf_counter()

@@ -47,9 +47,10 @@ def measure(ros: RosClient, mode: str, real_time_factor: float) -> tuple[float, 
         with running("acti_bringup", *params) as job:
             ros.call(srv.ServoON, ARM + "servo_on")
             ros.call(srv.SetSpeedJoint, ARM + "set_speed_joint", spd_ratio=1)
-            r = ros.call(srv.MovePTPJointRel, ARM + "move_ptp_joint_rel",
-                         joint_points=[150.0, 0, 0, 0, 0, 0, 0])
-            assert r.return_id.id == 0, r.return_id.comment
+            for j1 in (150.0, -150.0) * 3:     # back and forth: moving for the whole window,
+                r = ros.call(srv.MovePTPJointRel, ARM + "move_ptp_joint_rel",   # free-running too
+                             joint_points=[j1, 0, 0, 0, 0, 0, 0])
+                assert r.return_id.id == 0, r.return_id.comment
             if mode == "view on, one page":
                 url = re.search(r"live view: (\S+)", job.log()).group(1)
                 browser = open_browser(800, 500)

@@ -135,8 +135,10 @@ def simulated_arm(initial_joints_deg: tuple[float, ...], speed: int):
     return world, executor, arm
 
 
-def simulated_base(velocity: tuple[float, float], acceleration: tuple[float, float]):
-    """(world, executor, vehicle core) free-running, powered, servo on, with these settings."""
+def simulated_base(velocity: tuple[float, float] | None = None,
+                   acceleration: tuple[float, float] | None = None):
+    """(world, executor, vehicle core) free-running, powered, servo on, with these settings
+    (None: the start-up ones)."""
     from acti_motion.executor import MotionExecutor
     from acti_motion.vehicle.core import VehicleCore
     from acti_sim.world import World
@@ -145,8 +147,10 @@ def simulated_base(velocity: tuple[float, float], acceleration: tuple[float, flo
     base = VehicleCore(executor)
     base.set_power(True)
     base.set_servo(True)
-    base.set_velocity(velocity)
-    base.set_acceleration(acceleration)
+    if velocity is not None:
+        base.set_velocity(velocity)
+    if acceleration is not None:
+        base.set_acceleration(acceleration)
     return world, executor, base
 
 
