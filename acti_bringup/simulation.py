@@ -8,7 +8,7 @@ time, joints and transforms in its namespace: /robotN/clock, /robotN/joint_state
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable
 
 import rclpy
@@ -20,6 +20,7 @@ from sensor_msgs.msg import JointState
 
 from acti_bringup.camera import SimCamera
 from acti_bringup.parameters import declare_config
+from acti_bringup.priority import NICE_RANGE, set_niceness
 from acti_bringup.robot_graph import RobotGraph
 from acti_bringup.spinning import Planes, init, wait_for_signal
 from acti_motion.executor import MotionExecutor
@@ -35,6 +36,9 @@ class SimulationConfig:
     joint_state_rate_hz: float = 50.0   # joint_states (and the links' TF) publication rate [Hz]
     # rate of the simulated time on `clock` (/clock, or /<namespace>/clock) [Hz]; 0: not published
     clock_rate_hz: float = 100.0
+    # niceness of the process's threads, -20 … 19 (lower runs first: the control loop before
+    # the clients on a busy machine); below 0 needs CAP_SYS_NICE (root), else it is kept as is
+    nice: int = field(default=-10, metadata={"range": NICE_RANGE})
 
 
 def stamp(node_time: float) -> Time:
@@ -50,6 +54,7 @@ class Simulation:
         # Service threads wait for the GIL while the simulation thread computes; a short switch
         # interval bounds that wait (the default 5 ms would dominate every round trip).
         sys.setswitchinterval(SWITCH_INTERVAL_S)
+        set_niceness(c.nice, node.get_logger().warning)
         if c.rate_hz <= 0 or c.real_time_factor < 0 or c.joint_state_rate_hz <= 0 \
                 or c.clock_rate_hz < 0:
             raise ValueError("rate_hz and joint_state_rate_hz must be > 0, real_time_factor and "

@@ -5,6 +5,7 @@ what the physics did (joint positions, wheel rotation, ground-truth base pose, b
 """
 from __future__ import annotations
 
+import functools
 import math
 import os
 from dataclasses import dataclass
@@ -12,7 +13,6 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet
 import pybullet_data
-from pybullet_utils import bullet_client
 
 URDF_PATH = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
                          "urdf", "mobile_manipulator.urdf")
@@ -21,6 +21,20 @@ GRIPPER_JOINTS = ("gripper_finger_left_joint", "gripper_finger_right_joint")
 WHEEL_JOINTS = ("left_wheel_joint", "right_wheel_joint")
 BUMPER_LINK = "bumper"
 CASTER_LINKS = ("front_caster", "rear_caster")
+
+
+class PhysicsClient:
+    """PyBullet's functions bound to one physics client. pybullet_utils' BulletClient binds them
+    anew on every attribute access (an `inspect` call and a partial each time, several times a
+    step); here each is bound once, on first use."""
+
+    def __init__(self) -> None:
+        self._id = pybullet.connect(pybullet.DIRECT)
+
+    def __getattr__(self, name: str):
+        fn = functools.partial(getattr(pybullet, name), physicsClientId=self._id)
+        setattr(self, name, fn)
+        return fn
 
 
 @dataclass(frozen=True)
@@ -39,7 +53,7 @@ class World:
         self.time_step = time_step
         self.time = 0.0
         self.urdf_path = urdf_path
-        self._p = bullet_client.BulletClient(connection_mode=pybullet.DIRECT)
+        self._p = PhysicsClient()
         p = self._p
         p.setAdditionalSearchPath(pybullet_data.getDataPath())
         p.setGravity(0, 0, -9.81)

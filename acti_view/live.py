@@ -102,7 +102,9 @@ class LiveView:
             deadline = max(deadline + self.period, time.monotonic() - self.period)
             if self._stop.wait(max(0.0, deadline - time.monotonic())):
                 return
-            if not self.server.get_clients():
+            watched = bool(self.server.get_clients())
+            self.reader.sampler.active = watched
+            if not watched:
                 continue                    # nobody looks: costs nothing
             try:
                 self.update(self.reader.read())

@@ -31,14 +31,17 @@ class WorldSample:
 
 
 class WorldSampler:
-    """Copies what the view needs from the world on the simulation thread, every `every` steps."""
+    """Copies what the view needs from the world on the simulation thread, every `every` steps
+    while `active` (the view sets it while a page is open: with none it costs nothing)."""
 
     def __init__(self, executor: MotionExecutor, every: int) -> None:
         self.latest = self._read(executor.world)
+        self.active = False
         executor.after_step(self._sample, every=every)
 
     def _sample(self, world: World) -> None:
-        self.latest = self._read(world)
+        if self.active:
+            self.latest = self._read(world)
 
     @staticmethod
     def _read(world: World) -> WorldSample:

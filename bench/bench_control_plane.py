@@ -9,6 +9,7 @@ the same run (the /clock increment). Goals: stop reply p99 <= 3x bare, rest with
 time + 2 control periods, /clock never silent for more than 2 control periods.
 
     python bench/bench_control_plane.py            (a few minutes)
+    python bench/bench_control_plane.py --cases cd (only cases (c) and (d))
     python bench/bench_control_plane.py --storm S  (one storm client for S seconds: used by (d))
 """
 from __future__ import annotations
@@ -51,7 +52,8 @@ class Background:
         import rclpy
         from rclpy.executors import SingleThreadedExecutor
         self.node = rclpy.create_node("bench_background")
-        self.clock_arrivals: list[float] = []
+        self.clock_arrivals: list[float] = []       # here (monotonic)
+        self.clock_sent: list[float] = []           # by the job (DDS source timestamp, wall)
         self.clock_values: list[float] = []
         self.node.create_subscription(Clock, "/clock", self._on_clock, 100)
         self.executor = SingleThreadedExecutor()
@@ -60,8 +62,9 @@ class Background:
         self._thread = threading.Thread(target=self.executor.spin, daemon=True)
         self._thread.start()
 
-    def _on_clock(self, msg: Clock) -> None:
+    def _on_clock(self, msg: Clock, info: dict) -> None:
         self.clock_arrivals.append(time.monotonic())
+        self.clock_sent.append(info["source_timestamp"] * 1e-9)
         self.clock_values.append(msg.clock.sec + msg.clock.nanosec * 1e-9)
 
     def send(self, srv_type: type, name: str, **fields: Any) -> Any:
@@ -70,10 +73,17 @@ class Background:
         assert client.wait_for_service(timeout_sec=30.0)
         return client.call_async(srv_type.Request(**fields))
 
-    def largest_clock_gap(self, since: float, until: float) -> float:
-        t = np.array(self.clock_arrivals)
-        t = t[(t >= since) & (t <= until)]
-        return float(np.max(np.diff(t))) if len(t) > 1 else float("inf")
+    def largest_clock_gaps(self, since: float, until: float) -> tuple[float, float]:
+        """The largest gap between two /clock messages as the job sent them (their DDS source
+        timestamps: the job's own silence) and as they arrived here (adding this client's
+        delays: a storm takes both cores from it too)."""
+        n = len(self.clock_sent)                     # both lists grow on the spin thread
+        arrived = np.array(self.clock_arrivals[:n])
+        inside = (arrived >= since) & (arrived <= until)
+        if inside.sum() < 2:
+            return float("inf"), float("inf")
+        sent = np.array(self.clock_sent[:n])[inside]
+        return float(np.max(np.diff(sent))), float(np.max(np.diff(arrived[inside])))
 
     def control_period(self) -> float:
         return float(np.median(np.diff(np.array(self.clock_values[-500:]))))
@@ -153,8 +163,9 @@ class Figures:
     reply: list[float]
     bare: list[float]
     rest: list[float]
-    clock_gap: float
-    lost: int            # trials with a call never answered (DDS lost it: see the README)
+    clock_gap: float     # the job's largest /clock silence (source timestamps)
+    clock_arrival_gap: float     # ... as seen by this client
+    lost: list[str]      # the step each lost trial timed out in
 
 
 Load = Callable[[Device, int, int], Any]      # (device, trial, its motion id) → what it holds
@@ -171,35 +182,48 @@ def started(ros: RosClient, device: Device, trial: int) -> int:
     raise RuntimeError(f"{device.name}: no motion accepted in 100 tries")
 
 
+def running_motion(ros: RosClient, device: Device, waiter: Actions, trial: int) -> tuple[int, Any]:
+    """The trial's motion, once it runs, and the result of a wait on it. A move sent while the
+    device decelerates from a stop is accepted and then discarded with the rest of the queue
+    (spec 5.4.19): under a storm the previous trial's last stop can still be decelerating, so a
+    motion that ends before it ran is started again."""
+    for _ in range(20):
+        motion_id = started(ros, device, trial)
+        current: list[int] = []
+        goal = waiter.send(lambda f: current.append(f.feedback.current_motion_id),
+                           motion_id=motion_id, timeout=30.0)
+        result = goal.get_result_async()
+        if not ros.spin_until(lambda: motion_id in current or result.done(), 30.0):
+            raise TimeoutError("the motion neither ran nor ended")
+        if motion_id in current:
+            return motion_id, result
+    raise TimeoutError("every motion was discarded before it ran")
+
+
 def run_trials(ros: RosClient, bg: Background, device: Device, load: Load,
                waiter: Actions) -> Figures:
     reply: list[float] = []
     base: list[float] = []
     rest: list[float] = []
-    lost = 0
+    lost: list[str] = []
     for trial in range(-1, TRIALS):                     # trial -1 warms up (lazy imports)
         if trial == 0:
             reply.clear(), base.clear(), rest.clear()
-            lost, t0 = 0, time.monotonic()
+            lost, t0 = [], time.monotonic()
         try:
             trial_figures(ros, bg, device, load, waiter, trial, reply, base, rest)
-        except TimeoutError:
-            lost += 1
+        except TimeoutError as e:
+            lost.append(str(e))
+            print(f"  {device.name} trial {trial}: {e}", file=sys.stderr, flush=True)
             ros.call(device.stop_srv, device.path + "stop")
-    return Figures(reply, base, rest, bg.largest_clock_gap(t0, time.monotonic()), lost)
+    return Figures(reply, base, rest, *bg.largest_clock_gaps(t0, time.monotonic()), lost)
 
 
 def trial_figures(ros: RosClient, bg: Background, device: Device, load: Load, waiter: Actions,
                   trial: int, reply: list, base: list, rest: list) -> None:
     """One trial: start, load, bare call, stop, rest; the figures appended."""
     bare = bare_call(ros)
-    motion_id = started(ros, device, trial)
-    current = []
-    goal = waiter.send(lambda f: current.append(f.feedback.current_motion_id),
-                       motion_id=motion_id, timeout=30.0)
-    result = goal.get_result_async()
-    if not ros.spin_until(lambda: motion_id in current, 30.0):
-        raise TimeoutError("the motion never ran")
+    motion_id, result = running_motion(ros, device, waiter, trial)
     held = load(device, trial, motion_id)
     t = time.perf_counter()
     bare()
@@ -284,11 +308,20 @@ def scenarios(ros: RosClient, bg: Background) -> dict[str, tuple[Load, Callable[
     }
 
 
+def lost_text(lost: list[str]) -> str:
+    """How many trials lost a call, and in which step."""
+    if not lost:
+        return ""
+    return f"  {len(lost)} trials lost a call: " + "; ".join(
+        f"{lost.count(why)}x {why}" for why in dict.fromkeys(lost))
+
+
 def ms(x: float) -> str:
     return f"{x * 1e3:7.2f}"
 
 
-def main() -> None:
+def main(cases: str) -> None:
+    """`cases`: the letters of the cases to run (all when empty)."""
     ros = RosClient(call_timeout=5.0)
     # /clock on every control step (clock_rate_hz = rate_hz), so its gaps show every stall
     params = (f"max_action_goals:={MAX_GOALS}", f"max_wait_goals:={MAX_GOALS}",
@@ -303,6 +336,8 @@ def main() -> None:
         print(f"{'case':<40} {'dev':<5} {'bare p50/p99':>15} {'stop reply p50/p99/max':>25} "
               f"{'ratio p99':>9} {'rest p50/p99/max':>25} {'goal':>7} {'/clock gap':>10}")
         for name, (load, context) in scenarios(ros, bg).items():
+            if cases and name[1] not in cases:
+                continue
             with context():
                 for device in DEVICES:
                     waiter = Actions(ros, device.wait_action, device.path + "wait_motion")
@@ -314,8 +349,8 @@ def main() -> None:
                           f"{reply.max() * 1e3:8.2f} {p(reply, 99) / p(np.array(f.bare), 99):9.2f}"
                           f" {p(rest, 50):7.1f}/{p(rest, 99):7.1f}/{rest.max() * 1e3:7.1f}"
                           f" {goal * 1e3:7.1f} {f.clock_gap * 1e3:7.1f} "
-                          f"({f.clock_gap / period:.1f} periods)"
-                          + (f"  {f.lost} trials lost a call" if f.lost else ""))
+                          f"({f.clock_gap / period:.1f} periods; {f.clock_arrival_gap * 1e3:.1f}"
+                          f" as it arrived)" + lost_text(f.lost))
         bg.close()
     ros.close()
 
@@ -324,4 +359,4 @@ if __name__ == "__main__":
     if len(sys.argv) == 3 and sys.argv[1] == "--storm":
         storm_client(float(sys.argv[2]))
     else:
-        main()
+        main(sys.argv[sys.argv.index("--cases") + 1] if "--cases" in sys.argv else "")

@@ -1,10 +1,12 @@
 """The control plane over DDS on the main job (both nodes, one process): with more action goals
 offered than the bound, the goals beyond it are rejected and stop, get_state and resume are
 answered at once while the others wait; ~/wait_motion's timeout, cancel, discarded and refused
-(NaN, inf, negative timeout) cases for the arm and the base."""
+(NaN, inf, negative timeout) cases for the arm and the base; the job's threads run above its
+clients' (niceness -10)."""
 from __future__ import annotations
 
 import math
+import os
 import time
 from dataclasses import dataclass
 from typing import Any, Callable
@@ -93,6 +95,18 @@ def timed(fn: Callable[[], Any]) -> tuple[Any, float]:
     t0 = time.monotonic()
     out = fn()
     return out, time.monotonic() - t0
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="lowering the niceness needs root")
+def test_every_thread_of_the_job_runs_above_the_clients(ros, job):
+    ros.call(srv.GetState, ARM + "get_state")            # the job serves
+
+    def nice(path: str) -> int:
+        with open(f"{path}/stat") as f:
+            return int(f.read().rsplit(")", 1)[1].split()[16])
+    tasks = f"/proc/{job.proc.pid}/task"
+    assert {nice(f"{tasks}/{tid}") for tid in os.listdir(tasks)} == {-10}
+    assert nice(f"/proc/{os.getpid()}") == 0
 
 
 def test_goals_beyond_the_bound_are_rejected_and_stop_is_answered_while_the_rest_wait(ros, job):

@@ -20,8 +20,21 @@ def robot():
     executor = MotionExecutor(world, real_time_factor=0.0)
     arm, base = ArmCore(executor, ArmConfig()), VehicleCore(executor)
     sampler = WorldSampler(executor, every=1)
+    sampler.active = True                         # a page is open
     yield executor, arm, base, Reader(sampler, arm, base)
     world.close()
+
+
+def test_the_world_is_sampled_only_while_a_page_is_open(robot):
+    executor, _arm, _base, reader = robot
+    sampler = reader.sampler
+    sampler.active = False
+    before = sampler.latest
+    executor.step()
+    assert sampler.latest is before
+    sampler.active = True
+    executor.step()
+    assert sampler.latest is not before
 
 
 def control(device, label):

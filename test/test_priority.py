@@ -1,0 +1,52 @@
+"""The job's threads run at the configured niceness (acti_bringup.priority); without the right
+to lower it the process keeps its own and says so, and runs on."""
+import os
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from acti_bringup.priority import set_niceness
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCRIPT = textwrap.dedent("""
+    import os, sys, threading
+    from acti_bringup.priority import set_niceness
+    def nice(tid):
+        with open(f"/proc/{tid}/stat") as f:
+            return int(f.read().rsplit(")", 1)[1].split()[16])
+    before = threading.Thread(target=threading.Event().wait, args=(5,), daemon=True)
+    before.start()
+    ok = set_niceness(int(sys.argv[1]), print)
+    later = []
+    after = threading.Thread(target=lambda: later.append(nice(threading.get_native_id())))
+    after.start(); after.join()
+    print(ok, nice(threading.get_native_id()), nice(before.native_id), later[0])
+""")
+
+
+def run(nice: int, without_cap_sys_nice: bool = False) -> list[str]:
+    # root keeps the right to lower a niceness unless its bounding set loses CAP_SYS_NICE
+    drop = ["setpriv", "--bounding-set", "-sys_nice"] if without_cap_sys_nice \
+        and os.geteuid() == 0 else []
+    out = subprocess.run([*drop, sys.executable, "-c", SCRIPT, str(nice)], cwd=ROOT,
+                         env={**os.environ, "PYTHONPATH": ROOT}, capture_output=True, text=True,
+                         timeout=60, check=True).stdout
+    return out.splitlines()
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="lowering the niceness needs root")
+def test_every_thread_and_every_later_one_gets_the_niceness():
+    assert run(-7) == ["True -7 -7 -7"]
+
+
+def test_a_refused_niceness_is_said_once_and_the_process_runs_on():
+    *said, last = run(-7, without_cap_sys_nice=True)
+    assert len(said) == 1 and "nice -7 refused" in said[0] and "CAP_SYS_NICE" in said[0]
+    assert last == "False 0 0 0"
+
+
+def test_a_niceness_outside_minus_20_to_19_is_refused():
+    with pytest.raises(ValueError, match="-20 … 19"):
+        set_niceness(20, print)
