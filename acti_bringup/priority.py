@@ -1,5 +1,8 @@
-"""The scheduling priority of a controller process: its threads (the simulation step, the
-serving planes, DDS's own) run before the clients' on a busy machine.
+"""What keeps a controller process's control loop from being delayed by the machine or by the
+process itself: the niceness of its threads, and the garbage collector's pauses.
+
+Niceness: its threads (the simulation step, the serving planes, DDS's own) run before the
+clients' on a busy machine.
 
 On 2 cores under a storm of 8 client processes, the main job at the clients' priority let
 /clock fall silent for 33 ms and a stopped arm came to rest 150 ms late: its threads waited for
@@ -10,6 +13,7 @@ keeps the niceness it has and says so once: it still runs, only without that mar
 """
 from __future__ import annotations
 
+import gc
 import os
 from typing import Callable
 
@@ -42,3 +46,15 @@ def set_niceness(nice: int, log: Callable[[str], None]) -> bool:
         return False
     return True
 
+
+
+def freeze_heap() -> int:
+    """Exempt every object made so far from garbage collection; how many there are.
+
+    A full collection of the built main job (~185 000 objects: rclpy, Pinocchio, TOPP-RA,
+    SciPy, viser) took ~95 ms, during which no thread ran Python: /clock fell silent for 72 ms
+    under a storm of clients. Start-up objects live as long as the process, so after start-up
+    they are frozen (gc.freeze) and a collection looks only at what serving makes."""
+    gc.collect()
+    gc.freeze()
+    return gc.get_freeze_count()

@@ -20,7 +20,7 @@ from sensor_msgs.msg import JointState
 
 from acti_bringup.camera import SimCamera
 from acti_bringup.parameters import declare_config
-from acti_bringup.priority import NICE_RANGE, set_niceness
+from acti_bringup.priority import NICE_RANGE, freeze_heap, set_niceness
 from acti_bringup.robot_graph import RobotGraph
 from acti_bringup.spinning import Planes, init, wait_for_signal
 from acti_motion.executor import MotionExecutor
@@ -102,6 +102,7 @@ class Simulation:
                    if hasattr(n, plane)]
         for helper in helpers:
             planes.add(helper.plane, [helper])
+        freeze_heap()
         self.executor.start()
         planes.start()
         try:

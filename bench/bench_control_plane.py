@@ -3,8 +3,11 @@ while (a) a long move is being planned, (b) the queue is full, (c) the most acti
 held, (d) 8 client processes storm getters and moves; and the largest /clock gap during each.
 
 Each trial starts a motion, loads the job, calls a bare std_srvs/Trigger (the baseline, same
-moment, same load) and then `stop`. Rest is when the stopped motion retires (a ~/wait_motion
-goal on it answers). Ratios are against the bare round trip and the control period measured in
+moment, same load) and then `stop`. Rest is when the stopped motion retires: when the job says
+that a ~/wait_motion goal on it ended (the DDS source timestamp of that goal status), and, as a
+second figure, when the goal's result reached this client (which adds this client's own delays:
+a storm takes both cores from it too). /clock gaps likewise: as the job sent them and as they
+arrived. Ratios are against the bare round trip and the control period measured in
 the same run (the /clock increment). Goals: stop reply p99 <= 3x bare, rest within the decel
 time + 2 control periods, /clock never silent for more than 2 control periods.
 
@@ -31,6 +34,8 @@ import rclpy
 from acti_msgs import srv
 from acti_msgs.action import VehicleWaitMotion, WaitMotion
 from acti_msgs.msg import CarPosWithElbow, VehiclePoint
+from action_msgs.msg import GoalStatus, GoalStatusArray
+from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosgraph_msgs.msg import Clock
 
 from acti_bringup.spinning import init, stop_requested
@@ -56,6 +61,12 @@ class Background:
         self.clock_sent: list[float] = []           # by the job (DDS source timestamp, wall)
         self.clock_values: list[float] = []
         self.node.create_subscription(Clock, "/clock", self._on_clock, 100)
+        # when the job declared each goal of ~/wait_motion ended (DDS source timestamp, wall)
+        self.goal_ended: dict[bytes, float] = {}
+        status_qos = QoSProfile(depth=100, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        for path in (ARM, BASE):
+            self.node.create_subscription(GoalStatusArray, path + "wait_motion/_action/status",
+                                          self._on_status, status_qos)
         self.executor = SingleThreadedExecutor()
         self.executor.add_node(self.node)
         self._clients: dict[str, Any] = {}
@@ -66,6 +77,12 @@ class Background:
         self.clock_arrivals.append(time.monotonic())
         self.clock_sent.append(info["source_timestamp"] * 1e-9)
         self.clock_values.append(msg.clock.sec + msg.clock.nanosec * 1e-9)
+
+    def _on_status(self, msg: GoalStatusArray, info: dict) -> None:
+        for s in msg.status_list:
+            if s.status >= GoalStatus.STATUS_SUCCEEDED:
+                self.goal_ended.setdefault(bytes(s.goal_info.goal_id.uuid),
+                                           info["source_timestamp"] * 1e-9)
 
     def send(self, srv_type: type, name: str, **fields: Any) -> Any:
         client = self._clients.get(name) or self._clients.setdefault(
@@ -162,7 +179,8 @@ def long_plan(ros: RosClient, bg: Background, device: Device, trial: int) -> Any
 class Figures:
     reply: list[float]
     bare: list[float]
-    rest: list[float]
+    rest: list[float]    # stop called → the wait's result here
+    rest_job: list[float]    # stop called → the job said the wait ended (status source stamp)
     clock_gap: float     # the job's largest /clock silence (source timestamps)
     clock_arrival_gap: float     # ... as seen by this client
     lost: list[str]      # the step each lost trial timed out in
@@ -182,8 +200,9 @@ def started(ros: RosClient, device: Device, trial: int) -> int:
     raise RuntimeError(f"{device.name}: no motion accepted in 100 tries")
 
 
-def running_motion(ros: RosClient, device: Device, waiter: Actions, trial: int) -> tuple[int, Any]:
-    """The trial's motion, once it runs, and the result of a wait on it. A move sent while the
+def running_motion(ros: RosClient, device: Device, waiter: Actions,
+                   trial: int) -> tuple[int, Any, Any]:
+    """The trial's motion, once it runs, and the goal handle and result of a wait on it. A move sent while the
     device decelerates from a stop is accepted and then discarded with the rest of the queue
     (spec 5.4.19): under a storm the previous trial's last stop can still be decelerating, so a
     motion that ends before it ran is started again."""
@@ -196,44 +215,45 @@ def running_motion(ros: RosClient, device: Device, waiter: Actions, trial: int) 
         if not ros.spin_until(lambda: motion_id in current or result.done(), 30.0):
             raise TimeoutError("the motion neither ran nor ended")
         if motion_id in current:
-            return motion_id, result
+            return motion_id, goal, result
     raise TimeoutError("every motion was discarded before it ran")
 
 
 def run_trials(ros: RosClient, bg: Background, device: Device, load: Load,
                waiter: Actions) -> Figures:
-    reply: list[float] = []
-    base: list[float] = []
-    rest: list[float] = []
-    lost: list[str] = []
+    f = Figures([], [], [], [], 0.0, 0.0, [])
     for trial in range(-1, TRIALS):                     # trial -1 warms up (lazy imports)
         if trial == 0:
-            reply.clear(), base.clear(), rest.clear()
-            lost, t0 = [], time.monotonic()
+            f, t0 = Figures([], [], [], [], 0.0, 0.0, []), time.monotonic()
         try:
-            trial_figures(ros, bg, device, load, waiter, trial, reply, base, rest)
+            trial_figures(ros, bg, device, load, waiter, trial, f)
         except TimeoutError as e:
-            lost.append(str(e))
+            f.lost.append(str(e))
             print(f"  {device.name} trial {trial}: {e}", file=sys.stderr, flush=True)
             ros.call(device.stop_srv, device.path + "stop")
-    return Figures(reply, base, rest, *bg.largest_clock_gaps(t0, time.monotonic()), lost)
+    f.clock_gap, f.clock_arrival_gap = bg.largest_clock_gaps(t0, time.monotonic())
+    return f
 
 
 def trial_figures(ros: RosClient, bg: Background, device: Device, load: Load, waiter: Actions,
-                  trial: int, reply: list, base: list, rest: list) -> None:
+                  trial: int, f: Figures) -> None:
     """One trial: start, load, bare call, stop, rest; the figures appended."""
     bare = bare_call(ros)
-    motion_id, result = running_motion(ros, device, waiter, trial)
+    motion_id, goal, result = running_motion(ros, device, waiter, trial)
     held = load(device, trial, motion_id)
     t = time.perf_counter()
     bare()
-    base.append(time.perf_counter() - t)
-    t = time.perf_counter()
+    f.bare.append(time.perf_counter() - t)
+    wall, t = time.time(), time.perf_counter()
     ros.call(device.stop_srv, device.path + "stop")
-    reply.append(time.perf_counter() - t)
+    f.reply.append(time.perf_counter() - t)
     if not ros.wait(result, 30.0):
         raise TimeoutError("the stopped motion never retired")
-    rest.append(time.perf_counter() - t)
+    f.rest.append(time.perf_counter() - t)
+    uuid = bytes(goal.goal_id.uuid)
+    if not ros.spin_until(lambda: uuid in bg.goal_ended, 5.0):
+        raise TimeoutError("no goal status said the wait ended")
+    f.rest_job.append(bg.goal_ended[uuid] - wall)
     ros.call(device.stop_srv, device.path + "stop")     # what a load queued meanwhile
     if isinstance(held, list):
         for future in held:                              # held goals end with the motion
@@ -280,7 +300,8 @@ def storm_client(seconds: float) -> None:
     rclpy.try_shutdown()
 
 
-def scenarios(ros: RosClient, bg: Background) -> dict[str, tuple[Load, Callable[[], Any]]]:
+def scenarios(ros: RosClient, bg: Background,
+              waiters: dict[str, Actions]) -> dict[str, tuple[Load, Callable[[], Any]]]:
     """name → (per-trial load, context around the whole case)."""
     def planning(device: Device, trial: int, _motion_id: int) -> Any:
         future = long_plan(ros, bg, device, trial)
@@ -293,8 +314,7 @@ def scenarios(ros: RosClient, bg: Background) -> dict[str, tuple[Load, Callable[
 
     def most_goals(device: Device, _trial: int, motion_id: int) -> list:
         """All the slots but the trial's own wait, on the trial's motion: the results."""
-        goals = Actions(ros, device.wait_action, device.path + "wait_motion")
-        return [goals.send(motion_id=motion_id, timeout=60.0).get_result_async()
+        return [waiters[device.name].send(motion_id=motion_id, timeout=60.0).get_result_async()
                 for _ in range(MAX_GOALS - 1)]
 
     def nothing(_device: Device, _trial: int, _motion_id: int) -> None:
@@ -334,21 +354,25 @@ def main(cases: str) -> None:
         print(f"stop under load, main job, {TRIALS} trials per case; control period "
               f"{period * 1e3:.2f} ms (from /clock); times in ms")
         print(f"{'case':<40} {'dev':<5} {'bare p50/p99':>15} {'stop reply p50/p99/max':>25} "
-              f"{'ratio p99':>9} {'rest p50/p99/max':>25} {'goal':>7} {'/clock gap':>10}")
-        for name, (load, context) in scenarios(ros, bg).items():
+              f"{'ratio p99':>9} {'rest p50/p99/max':>25} {'goal':>7} {'received p99':>12} "
+              f"{'/clock gap':>10}")
+        # one action client per device for the whole run: each new one would add entities to
+        # both processes (and receivers of every goal status) for the rest of the run
+        waiters = {d.name: Actions(ros, d.wait_action, d.path + "wait_motion") for d in DEVICES}
+        for name, (load, context) in scenarios(ros, bg, waiters).items():
             if cases and name[1] not in cases:
                 continue
             with context():
                 for device in DEVICES:
-                    waiter = Actions(ros, device.wait_action, device.path + "wait_motion")
-                    f = run_trials(ros, bg, device, load, waiter)
-                    reply, rest = np.array(f.reply), np.array(f.rest)
+                    f = run_trials(ros, bg, device, load, waiters[device.name])
+                    reply, rest = np.array(f.reply), np.array(f.rest_job)
                     goal = device.decel_s + 2 * period
                     print(f"{name:<40} {device.name:<5} {p(np.array(f.bare), 50):7.2f}/"
                           f"{p(np.array(f.bare), 99):7.2f} {p(reply, 50):7.2f}/{p(reply, 99):7.2f}/"
                           f"{reply.max() * 1e3:8.2f} {p(reply, 99) / p(np.array(f.bare), 99):9.2f}"
                           f" {p(rest, 50):7.1f}/{p(rest, 99):7.1f}/{rest.max() * 1e3:7.1f}"
-                          f" {goal * 1e3:7.1f} {f.clock_gap * 1e3:7.1f} "
+                          f" {goal * 1e3:7.1f} {p(np.array(f.rest), 99):12.1f}"
+                          f" {f.clock_gap * 1e3:7.1f} "
                           f"({f.clock_gap / period:.1f} periods; {f.clock_arrival_gap * 1e3:.1f}"
                           f" as it arrived)" + lost_text(f.lost))
         bg.close()
