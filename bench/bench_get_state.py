@@ -1,6 +1,9 @@
 """Control-plane round trips of the main job (both nodes, one world, idle) against a bare
 std_srvs/Trigger server: get_state and every getter of both nodes, each interleaved with the
-baseline (bare, getter, bare, getter …); then the main job's CPU use while idle."""
+baseline (bare, getter, bare, getter …); then the main job's CPU use while idle (over 20 s,
+3 s after the last call)."""
+import time
+
 from common import (RosClient, against, bare_call, idle_cpu_percent, interleaved, running, table,
                     worst_ratios)
 
@@ -18,7 +21,8 @@ def main() -> None:
     with running("bench.trigger_server"), running("acti_bringup") as job:
         getters = [(name, lambda s=srv_type, n=name: ros.call(s, n)) for name, srv_type in GETTERS]
         samples = interleaved(against(("bare Trigger", bare_call(ros)), getters), N)
-        cpu = idle_cpu_percent(job.proc.pid)
+        time.sleep(3.0)          # the calls' tail (DDS acknowledgements, collections) ends
+        cpu = idle_cpu_percent(job.proc.pid, seconds=20.0)
     table(f"round trip over DDS, {N} rounds of (bare, getter) for each of {len(GETTERS)} getters; "
           f"main job idle, simulation at real time", samples, "bare Trigger")
     p50, p99 = worst_ratios(samples, "bare Trigger")
