@@ -198,11 +198,13 @@ def test_offsets_refuse_non_transforms(arm, offset, words):
 def test_base_offset_moves_the_robot_frame(arm):
     # the robot frame is 100 mm ahead of the arm frame and turned 90° about z
     offset = [0.0, -1.0, 0.0, 100.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+    before = arm.get_feedback_pos_cartesian().values["pos"][0]    # same joint sample as below
     assert arm.set_base_offset(offset).ok
     assert arm.get_base_offset().values["offset"] == offset
     hg = arm.get_feedback_pos_cartesian().values["pos"][0]
     # arm-frame (163, 0) is robot-frame R⁻¹(p − t) = (0, -63)
     assert (hg[3], hg[7], hg[11]) == pytest.approx((0.0, -63.0, 1341.9395), abs=1e-3)
+    assert (before[3], before[7]) == pytest.approx((163.0, 0.0), abs=1e-3)
 
 
 def test_control_point_offset_moves_the_control_point(arm):

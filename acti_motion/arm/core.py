@@ -209,6 +209,7 @@ class ArmCore:
         self.device = executor.add_device("arm", c.queue_size,
                                           ArmSetpoint(q0.copy(), self._finger))
         self._inside: np.ndarray | None = None
+        self._cartesian_memo: tuple | None = None     # (joints sample, frames, its pose)
         executor.after_step(self._sample)
 
     def _apply_settings(self, c: ArmConfig) -> None:
@@ -357,7 +358,16 @@ class ArmCore:
     # === middle-level port: getters ==============================================================
     @returns(*GETTER)
     def get_feedback_pos_cartesian(self) -> dict:
-        return {"pos": self.car_pos_with_elbow(self._feedback)}
+        return {"pos": self._feedback_cartesian()}
+
+    def _feedback_cartesian(self) -> tuple[list[float], float, int]:
+        """The measured control-point pose, computed once per sample of the joints and setting
+        of the frames: the simulation thread samples every control period, and callers within
+        one period (a client polling at kHz) get the same pose without the kinematics again."""
+        q, frames, memo = self._feedback, self.frames, self._cartesian_memo
+        if memo is None or memo[0] is not q or memo[1] is not frames:
+            memo = self._cartesian_memo = (q, frames, self.car_pos_with_elbow(q))
+        return memo[2]
 
     @returns(*GETTER)
     def get_base_offset(self) -> dict:
