@@ -20,7 +20,8 @@ from sensor_msgs.msg import JointState
 
 from acti_bringup.camera import SimCamera
 from acti_bringup.parameters import declare_config
-from acti_bringup.priority import NICE_RANGE, freeze_heap, set_niceness
+from acti_bringup.priority import (FIFO_RANGE, NICE_RANGE, check_fifo_priority, freeze_heap,
+                                   set_fifo, set_niceness)
 from acti_bringup.robot_graph import RobotGraph
 from acti_bringup.spinning import Planes, init, wait_for_signal
 from acti_motion.executor import MotionExecutor
@@ -39,6 +40,10 @@ class SimulationConfig:
     # niceness of the process's threads, -20 … 19 (lower runs first: the control loop before
     # the clients on a busy machine); below 0 needs CAP_SYS_NICE (root), else it is kept as is
     nice: int = field(default=-10, metadata={"range": NICE_RANGE})
+    # SCHED_FIFO priority of the simulation (control loop) thread, 1 … 99; 0: ordinary
+    # scheduling. Needs CAP_SYS_NICE (root), else it runs at ordinary priority; not applied
+    # when real_time_factor is 0 (a loop that never sleeps would keep a core to itself)
+    control_fifo_priority: int = field(default=10, metadata={"range": FIFO_RANGE})
 
 
 def stamp(node_time: float) -> Time:
@@ -59,6 +64,8 @@ class Simulation:
                 or c.clock_rate_hz < 0:
             raise ValueError("rate_hz and joint_state_rate_hz must be > 0, real_time_factor and "
                              "clock_rate_hz >= 0")
+        check_fifo_priority(c.control_fifo_priority)       # here, not on the simulation thread
+        self._log = node.get_logger()
         self.world = World(time_step=1.0 / c.rate_hz)
         self.executor = MotionExecutor(self.world, c.real_time_factor, alive=node.context.ok)
         if c.clock_rate_hz > 0:
@@ -79,6 +86,15 @@ class Simulation:
             if any(p.get_subscription_count() for p in publishers):
                 publish(world)
         self.executor.after_step(listened, every=self.executor.steps_per_period(rate_hz))
+
+    def _schedule_control_loop(self) -> None:
+        """On the simulation thread: real-time scheduling when the simulation keeps time."""
+        priority = self.config.control_fifo_priority
+        if priority and self.config.real_time_factor == 0:
+            self._log.info("control_fifo_priority not applied: real_time_factor 0 runs the "
+                           "simulation as fast as it can")
+            return
+        set_fifo(priority, self._log.warning)
 
     def now(self) -> Time:
         return stamp(self.world.time)
@@ -103,7 +119,7 @@ class Simulation:
         for helper in helpers:
             planes.add(helper.plane, [helper])
         freeze_heap()
-        self.executor.start()
+        self.executor.start(prepare=self._schedule_control_loop)
         planes.start()
         try:
             wait_for_signal(planes.serving)

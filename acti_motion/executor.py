@@ -430,9 +430,12 @@ class MotionExecutor:
         """Between start and shutdown, while the host process still runs."""
         return self._running.is_set() and self._alive()
 
-    def start(self) -> None:
+    def start(self, prepare: Callable[[], None] = lambda: None) -> None:
+        """Step on a thread of its own, which first runs `prepare()` (the host sets that
+        thread's scheduling there)."""
         self._running.set()
-        self._thread = threading.Thread(target=self._loop, name="acti-sim", daemon=True)
+        self._thread = threading.Thread(target=self._loop, args=(prepare,), name="acti-sim",
+                                        daemon=True)
         self._thread.start()
 
     def shutdown(self) -> None:
@@ -441,7 +444,8 @@ class MotionExecutor:
             self._thread.join(timeout=5.0)
             self._thread = None
 
-    def _loop(self) -> None:
+    def _loop(self, prepare: Callable[[], None]) -> None:
+        prepare()
         wall0 = time.monotonic()
         sim0 = self.world.time
         while self._running.is_set() and self._alive():
