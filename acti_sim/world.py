@@ -92,6 +92,7 @@ class World:
         self._movable_names = [p.getJointInfo(self.robot, j)[1].decode() for j in self._movable]
         self.reset_arm(np.zeros(len(ARM_JOINTS)))
         self.set_gripper_target(0.0)
+        self._wheel_target: tuple[float, float] | None = None
         self.set_wheel_velocities(0.0, 0.0)
         self.wheel_radius = 0.10
         self.wheel_separation = 0.50
@@ -169,7 +170,11 @@ class World:
 
     # --- base ------------------------------------------------------------------------------
     def set_wheel_velocities(self, left: float, right: float) -> None:
-        """Wheel angular velocities (rad/s) through torque-limited velocity motors."""
+        """Wheel angular velocities (rad/s) through torque-limited velocity motors. A motor
+        keeps its target, so the same target again (a base at rest, every step) is not sent."""
+        if (left, right) == self._wheel_target:
+            return
+        self._wheel_target = (left, right)
         eff = self.limits[WHEEL_JOINTS[0]].effort
         self._p.setJointMotorControlArray(
             self.robot, self._wheel_ids, pybullet.VELOCITY_CONTROL,
