@@ -87,6 +87,8 @@ class World:
         self._arm_ids = [self._joint[n] for n in ARM_JOINTS]
         self._grip_ids = [self._joint[n] for n in GRIPPER_JOINTS]
         self._wheel_ids = [self._joint[n] for n in WHEEL_JOINTS]
+        self._sensed_ids = [*self._arm_ids, self._grip_ids[0], *self._wheel_ids]
+        self._positions: list[float] | None = None
         self._movable = [j for j in self._joint.values()
                          if p.getJointInfo(self.robot, j)[2] != pybullet.JOINT_FIXED]
         self._movable_names = [p.getJointInfo(self.robot, j)[1].decode() for j in self._movable]
@@ -102,7 +104,15 @@ class World:
 
     def step(self) -> None:
         self._p.stepSimulation()
+        self._positions = None
         self.time += self.time_step
+
+    def _sensed(self) -> list[float]:
+        """Positions of the arm joints, the gripper finger and the wheels, read from PyBullet
+        once per state of the world (the cores sample all of them every step)."""
+        if self._positions is None:
+            self._positions = [s[0] for s in self._p.getJointStates(self.robot, self._sensed_ids)]
+        return self._positions
 
     def render(self, eye: tuple[float, float, float], target: tuple[float, float, float],
                fov_deg: float, width: int, height: int, shadow: bool = False) -> np.ndarray:
@@ -129,6 +139,7 @@ class World:
         self._p.resetBasePositionAndOrientation(self.robot, pos, orn)
         for j, q in zip(self._movable, joints):
             self._p.resetJointState(self.robot, j, q)
+        self._positions = None
 
     def joint_states(self) -> tuple[list[str], list[float], list[float]]:
         """Names, positions and velocities of every movable joint (rad, m; rad/s, m/s)."""
@@ -140,6 +151,7 @@ class World:
         """Place the arm at q (rad) at rest and hold it there (start-up posture)."""
         for j, qi in zip(self._arm_ids, q):
             self._p.resetJointState(self.robot, j, float(qi))
+        self._positions = None
         self.set_arm_targets(np.asarray(q, float))
 
     def set_arm_targets(self, q: np.ndarray, qd: np.ndarray | None = None) -> None:
@@ -152,7 +164,7 @@ class World:
             positionGains=[0.3] * len(q), velocityGains=[1.0] * len(q))
 
     def arm_positions(self) -> np.ndarray:
-        return np.array([s[0] for s in self._p.getJointStates(self.robot, self._arm_ids)])
+        return np.array(self._sensed()[:len(self._arm_ids)])
 
     def arm_velocities(self) -> np.ndarray:
         return np.array([s[1] for s in self._p.getJointStates(self.robot, self._arm_ids)])
@@ -166,7 +178,7 @@ class World:
             positionGains=[0.3] * 2)
 
     def gripper_position(self) -> float:
-        return float(self._p.getJointState(self.robot, self._grip_ids[0])[0])
+        return self._sensed()[len(self._arm_ids)]
 
     # --- base ------------------------------------------------------------------------------
     def set_wheel_velocities(self, left: float, right: float) -> None:
@@ -182,7 +194,7 @@ class World:
 
     def wheel_positions(self) -> np.ndarray:
         """Unwrapped wheel angles (rad): PyBullet reports continuous joints without wrapping."""
-        return np.array([s[0] for s in self._p.getJointStates(self.robot, self._wheel_ids)])
+        return np.array(self._sensed()[-len(self._wheel_ids):])
 
     def base_pose(self) -> tuple[float, float, float]:
         """Ground truth (x, y, yaw) of base_link in the world frame (m, rad)."""
