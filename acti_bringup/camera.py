@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import multiprocessing
+import os
 import signal
 import threading
 from dataclasses import dataclass
@@ -89,8 +90,10 @@ def camera_info(width: int, height: int, fov_deg: float) -> CameraInfo:
 
 def render_frames(requests: Any, frames: Any, urdf_path: str, config: CameraConfig) -> None:
     """The render process: pose a copy of the world as asked, send back the RGB bytes; ends
-    when the simulation's end of the pipe closes. SIGINT is the host's to handle."""
+    when the simulation's end of the pipe closes. SIGINT is the host's to handle. It runs at
+    ordinary niceness (0), not the control loop's raised one: its frames may wait, the robot not."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    os.setpriority(os.PRIO_PROCESS, 0, 0)
     world = World(urdf_path=urdf_path)
     c = config
     try:

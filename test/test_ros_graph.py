@@ -2,6 +2,7 @@
 get it), /tf + /tf_static of the standard type (Jazzy's type hash) holding every link, agreeing
 with the arm's and the base's own feedback; /odom continuous across set_position; the camera."""
 import math
+import os
 
 import numpy as np
 import pinocchio as pin
@@ -187,3 +188,22 @@ def test_camera_publishes_rgb_images_of_the_work_cell(ros, robot, tf):
     assert (info.width, info.height) == CAMERA and info.header.frame_id == image.header.frame_id
     assert info.k[2] == pytest.approx(width / 2 - 0.5) and info.k[0] == info.k[4] > 0
     assert ros.spin_until(lambda: image.header.frame_id in tf, 5.0)
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="the job's niceness -10 needs root")
+def test_the_renderer_runs_below_the_control_loop(robot):
+    """The render process (a child of the job) at niceness 0: its frames may wait, the robot not."""
+    def children(pid: int) -> list[int]:
+        tasks = f"/proc/{pid}/task"
+        return [int(c) for t in os.listdir(tasks)
+                for c in open(f"{tasks}/{t}/children").read().split()]
+
+    def nice(pid: int) -> int:
+        with open(f"/proc/{pid}/stat") as f:
+            return int(f.read().rsplit(")", 1)[1].split()[16])
+    def renderers() -> list[int]:         # python -c "from multiprocessing.spawn import …"
+        return [c for c in children(robot.proc.pid)
+                if b"spawn_main" in open(f"/proc/{c}/cmdline", "rb").read()]
+    # spawned at -10 like every thread of the job, it lowers itself once it runs
+    assert wait_until(lambda: [nice(c) for c in renderers()] == [0], 30.0)
+    assert nice(robot.proc.pid) == -10
