@@ -69,8 +69,8 @@ def set_fifo(priority: int, log: Callable[[str], None]) -> bool:
     at niceness −10 alone, the base's planning and its clients still held the simulation step
     back by up to 10–19 ms (/clock silent 13.8 and 22.7 ms in two runs of the same case); under
     SCHED_FIFO 10, 5.8 ms. It is what ros2_control's controller_manager asks for (priority 50).
-    The kernel's real-time throttling (95 % of each second by default) bounds a loop that
-    falls behind and steps without sleeping."""
+    Opt-in: a loop that falls behind steps without sleeping and then keeps a core from every
+    ordinary thread (the kernel's real-time throttling leaves them 5 % of each second)."""
     if check_fifo_priority(priority) == 0:
         return True
     try:

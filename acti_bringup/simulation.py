@@ -40,10 +40,12 @@ class SimulationConfig:
     # niceness of the process's threads, -20 … 19 (lower runs first: the control loop before
     # the clients on a busy machine); below 0 needs CAP_SYS_NICE (root), else it is kept as is
     nice: int = field(default=-10, metadata={"range": NICE_RANGE})
-    # SCHED_FIFO priority of the simulation (control loop) thread, 1 … 99; 0: ordinary
-    # scheduling. Needs CAP_SYS_NICE (root), else it runs at ordinary priority; not applied
-    # when real_time_factor is 0 (a loop that never sleeps would keep a core to itself)
-    control_fifo_priority: int = field(default=10, metadata={"range": FIFO_RANGE})
+    # SCHED_FIFO priority of the simulation (control loop) thread, 1 … 99; 0 (the default):
+    # ordinary scheduling. Opt-in: a loop that falls behind steps without sleeping, and at FIFO
+    # it then keeps a core from every ordinary thread (two 4x-real-time jobs on a busy 2-core
+    # machine starved a service call for 30 s). Needs CAP_SYS_NICE (root); not applied when
+    # real_time_factor is 0
+    control_fifo_priority: int = field(default=0, metadata={"range": FIFO_RANGE})
 
 
 def stamp(node_time: float) -> Time:
