@@ -22,7 +22,10 @@ import rclpy
 from rclpy.executors import Executor, SingleThreadedExecutor
 from rclpy.signals import SignalHandlerOptions
 from rclpy.experimental import EventsExecutor
+from rclpy.logging import get_logger
 from rclpy.node import Node
+
+from acti_bringup.responses import LateResponses
 
 SPIN_TIMEOUT_S = 0.5        # a loop's longest sleep: how soon it notices it should end
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -89,10 +92,14 @@ class Planes:
     def __init__(self) -> None:
         self.executors = {plane: kind() for plane, kind in self.KINDS.items()}
         self._loops: list[SpinLoop] = []
+        self._late = LateResponses(get_logger("acti_responses").warning)
 
     def add(self, plane: str, nodes: Iterable[Node]) -> None:
+        """Serve the nodes on the plane; a response DDS cannot deliver yet is sent again."""
+        nodes = list(nodes)
         for n in nodes:
             self.executors[plane].add_node(n)
+        self._late.serve(nodes)
 
     def start(self) -> None:
         self._loops = [SpinLoop(ex, f"ros-{plane}").start() for plane, ex in self.executors.items()]
