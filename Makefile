@@ -4,6 +4,7 @@ PYTHON ?= python3.11
 VENV := .venv
 PY := $(VENV)/bin/python
 ENV := source tools/env.sh
+BUILD_DEPS_STAMP := $(VENV)/.build-deps-stamp
 DEPS_STAMP := $(VENV)/.deps-stamp
 BUILD_STAMP = install/.build-stamp-cpp-$(ACTI_MSGS_CPP)
 COLCON_PATHS := --base-paths . msg_defs
@@ -14,7 +15,7 @@ INTERFACES := $(shell find msg_defs -type f -not -name '*~')
 ACTI_MSGS_CPP ?= OFF
 NPROC := $(shell nproc)
 # Every core for make (colcon's default -l also stops new jobs while the machine is busy), one
-# package per core, and ccache (from requirements.txt) keeping compiled objects between builds
+# package per core, and ccache (from requirements-build.txt) keeping compiled objects between builds
 # and clones: paths relative to the checkout, so another clone hits the same entries.
 BUILD_ENV := MAKEFLAGS=-j$(NPROC) CCACHE_BASEDIR=$(CURDIR) CCACHE_NOHASHDIR=true
 CMAKE_ARGS := -DBUILD_TESTING=OFF -DPython3_EXECUTABLE=$(abspath $(PY)) \
@@ -24,28 +25,42 @@ CMAKE_ARGS := -DBUILD_TESTING=OFF -DPython3_EXECUTABLE=$(abspath $(PY)) \
 BROWSER := /usr/lib/chromium/chromium-headless-shell /usr/bin/chromedriver
 VIEW_URL := http://127.0.0.1:8080/
 
-.PHONY: build run test bench clean browser
+.PHONY: build setup run test bench clean browser
 
 build: $(BUILD_STAMP)
+
+# Everything run and test need. The interface packages need only requirements-build.txt, so the
+# rest of the venv (PyBullet, Pinocchio, viser: most of the download) is installed while they
+# build: two jobs, whatever -j make was given.
+setup:
+	@$(MAKE) --no-print-directory -j2 $(BUILD_STAMP) $(DEPS_STAMP)
 
 # pip's HTTP cache keeps nothing from this registry, so the wheels are kept in a wheelhouse: a new
 # venv (another clone, `rm -r .venv`) installs from it without the network; the lock pins every
 # wheel. A requirement it lacks sends pip to the registry for the missing ones.
 WHEELHOUSE ?= $(HOME)/.cache/acti_ros2/wheels
 PIP := $(PY) -m pip --disable-pip-version-check
-REQUIREMENTS := -r requirements.txt -c requirements.lock
 
-$(DEPS_STAMP): requirements.txt requirements.lock tools/fix_cmake_paths.py
+# Install a requirements file from the wheelhouse; fetch into it what it lacks.
+define install_from_wheelhouse
+	$(PIP) install --quiet --no-index --find-links $(WHEELHOUSE) -r $(1) -c requirements.lock 2>/dev/null || { \
+	  $(PIP) wheel --quiet --find-links $(WHEELHOUSE) -w $(WHEELHOUSE) -r $(1) -c requirements.lock && \
+	  $(PIP) install --quiet --no-index --find-links $(WHEELHOUSE) -r $(1) -c requirements.lock; }
+endef
+
+$(BUILD_DEPS_STAMP): requirements-build.txt requirements.lock tools/fix_cmake_paths.py
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PIP) install --quiet --no-index --find-links $(WHEELHOUSE) $(REQUIREMENTS) 2>/dev/null || { \
-	  $(PIP) wheel --quiet --find-links $(WHEELHOUSE) -w $(WHEELHOUSE) $(REQUIREMENTS) && \
-	  $(PIP) install --quiet --no-index --find-links $(WHEELHOUSE) $(REQUIREMENTS); }
+	$(call install_from_wheelhouse,requirements-build.txt)
 	$(PY) tools/fix_cmake_paths.py $(VENV)
+	touch $@
+
+$(DEPS_STAMP): $(BUILD_DEPS_STAMP) requirements.txt
+	$(call install_from_wheelhouse,requirements.txt)
 	touch $@
 
 # Python sources need no rebuild: --symlink-install runs them from the tree. Our tf2_msgs
 # (msg_defs/tf2_msgs) is added only where no tf2_msgs is installed (tools/own_tf2_msgs.py).
-$(BUILD_STAMP): $(DEPS_STAMP) $(INTERFACES) package.xml setup.py setup.cfg tools/own_tf2_msgs.py
+$(BUILD_STAMP): $(BUILD_DEPS_STAMP) $(INTERFACES) package.xml setup.py setup.cfg tools/own_tf2_msgs.py
 	$(ENV) && $(BUILD_ENV) colcon --log-base log build $(COLCON_PATHS) $$(python tools/own_tf2_msgs.py) \
 	  --symlink-install --parallel-workers $(NPROC) --cmake-args $(CMAKE_ARGS)
 	touch $@
@@ -56,17 +71,17 @@ browser:
 	  DEBIAN_FRONTEND=noninteractive apt-get install -y chromium-headless-shell chromium-driver; \
 	  break; }; done
 
-run: build
+run: setup
 	@echo "live view: $(VIEW_URL) (the log says so if that port was taken; view_enabled:=false turns it off)"
 	$(ENV) && exec python -m acti_bringup --ros-args --params-file config/acti_ros2.yaml
 
-test: build browser
+test: setup browser
 	$(ENV) && colcon --log-base log test $(COLCON_PATHS) --packages-select acti_ros2 \
 	  --event-handlers console_direct+ --return-code-on-test-failure \
 	  --pytest-args -q -p no:cacheprovider
 	$(ENV) && colcon test-result --test-result-base build/acti_ros2 --verbose
 
-bench: build browser
+bench: setup browser
 	$(ENV) && for b in bench/bench_*.py; do echo "== $$b"; python "$$b" || exit 1; done
 
 clean:
