@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from typing import Any, Callable
 
 from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from acti_bringup.conversions import fill, request_reader
 from acti_motion.replies import Reply, ReturnCode
@@ -50,6 +51,13 @@ class Plane(Node):
 
 StatusWriter = Callable[[Any, Reply], None]
 
+# One response writer serves every client of a service. With the default history (10), a storm
+# of clients can push a starved client's response out of it before that client acknowledged it,
+# and a response the transport dropped (a full receive queue) can then never be repaired: that
+# client waits for ever. A deeper history keeps every response until its client has it.
+SERVICE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
+                         reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE)
+
 
 def serve_operations(node: Node, motion: Plane, core: Any,
                      operations: tuple[Operation, ...], write_status: StatusWriter) -> list:
@@ -59,7 +67,7 @@ def serve_operations(node: Node, motion: Plane, core: Any,
     for op in operations:
         handler = _handler(node, op, getattr(core, op.name), write_status)
         host, name = (motion, motion.name(op.name)) if op.plans else (node, f"~/{op.name}")
-        services.append(host.create_service(op.srv_type, name, handler))
+        services.append(host.create_service(op.srv_type, name, handler, qos_profile=SERVICE_QOS))
     node.get_logger().info(f"{len(services)} services under {node.get_fully_qualified_name()}/: "
                            + ", ".join(op.name for op in operations))
     return services
