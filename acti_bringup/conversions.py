@@ -67,16 +67,62 @@ def _build(cls: type, value: Any) -> Any:
     return msg
 
 
+# Messages built from core values, by field type and value: a getter answers the same limits,
+# offsets or pose again and again, and building its nested messages was most of its work (a
+# setter per field). They are shared read-only: a response is serialised as it is sent.
+_BUILT: dict[tuple[int, Any], Any] = {}
+_BUILT_MAX = 512
+
+
+def _frozen(value: Any) -> Any:
+    """A hashable copy of a core value (lists and arrays → tuples), or None if it has none."""
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    if isinstance(value, list):
+        value = tuple(value)
+    try:
+        hash(value)                 # the usual case at once: a tuple of numbers or of tuples
+        return value
+    except TypeError:
+        if not isinstance(value, tuple):
+            return None
+    items = tuple(_frozen(v) for v in value)
+    return None if None in items else items
+
+
 def _convert(slot: Any, value: Any) -> Any:
     if isinstance(slot, NamespacedType):
-        return _build(_message_class(slot), value)
+        return _cached(slot, value, lambda: _build(_message_class(slot), value))
     if isinstance(slot, AbstractNestedType):
         inner = slot.value_type
         if isinstance(inner, NamespacedType):
             cls = _message_class(inner)
-            return [_build(cls, v) for v in value]
-        return [_scalar(v) for v in value]
+            return _cached(slot, value, lambda: [_build(cls, v) for v in value])
+        if isinstance(value, np.ndarray):
+            return value.tolist()
+        return [v.item() if isinstance(v, np.generic) else v for v in value]
     return _scalar(value)
+
+
+_LAST: dict[int, tuple[Any, Any]] = {}     # per field type: the last core value and its build
+# (a value handed to `fill` is never changed afterwards: cores answer new or immutable values)
+
+
+def _cached(slot: Any, value: Any, build: Callable[[], Any]) -> Any:
+    last = _LAST.get(id(slot))
+    if last is not None and last[0] is value:   # a core that memoises answered the same object
+        return last[1]
+    frozen = _frozen(value)
+    if frozen is None:
+        return build()
+    key = (id(slot), frozen)
+    built = _BUILT.get(key)
+    if built is None:
+        if len(_BUILT) >= _BUILT_MAX:
+            _BUILT.clear()
+        built = _BUILT[key] = build()
+    _LAST[id(slot)] = (value, built)
+    return built
 
 
 def _scalar(v: Any) -> Any:

@@ -54,6 +54,7 @@ MOVE = (R.STATUS_ERR, R.VALUE_ERR, R.FULL_MOTION_QUEUE_ERR, R.NOT_SV_ON_ERR)
 CARTESIAN_WATCH_TOLERANCE_MM = 0.1
 REL_ELBOW_CLEARANCE = math.sin(math.radians(10.0))
 JOINT_WATCH_TOLERANCE_DEG = 1e-6
+REST_DRIFT_RAD = 1e-9                     # sensed joints this close give the same feedback pose
 
 # Bounds of the settings that keep the arm stoppable and every plan quick (README: arm settings).
 # A stop decelerates over the running move's accel time, so an accel time of minutes is a
@@ -136,6 +137,11 @@ def _offset(offset: list[float], bound_mm: float, code: ReturnCode) -> np.ndarra
         raise Refused(code, f"offset: a translation of {shift:.6g} mm: each axis must be within "
                             f"±{bound_mm:g} mm")
     return pose
+
+
+def _within(a: np.ndarray, b: np.ndarray, tol: float) -> bool:
+    """Every element of a within tol of b's (plain floats: numpy is slower for 7 values)."""
+    return all(abs(x - y) <= tol for x, y in zip(a.tolist(), b.tolist()))
 
 
 def _ignored(why: str) -> Reply:
@@ -363,9 +369,12 @@ class ArmCore:
     def _feedback_cartesian(self) -> tuple[list[float], float, int]:
         """The measured control-point pose, computed once per sample of the joints and setting
         of the frames: the simulation thread samples every control period, and callers within
-        one period (a client polling at kHz) get the same pose without the kinematics again."""
+        one period (a client polling at kHz) get the same pose without the kinematics again.
+        An arm at rest keeps its pose too: its sensed joints drift by ~1e-10 rad a step, and a
+        sample within REST_DRIFT_RAD of the one computed moves the control point by < 1 nm."""
         q, frames, memo = self._feedback, self.frames, self._cartesian_memo
-        if memo is None or memo[0] is not q or memo[1] is not frames:
+        if memo is None or memo[1] is not frames or (
+                memo[0] is not q and not _within(memo[0], q, REST_DRIFT_RAD)):
             memo = self._cartesian_memo = (q, frames, self.car_pos_with_elbow(q))
         return memo[2]
 
