@@ -4,7 +4,8 @@ A client that calls as soon as it has discovered the server can be answered befo
 discovered the client's response reader. Fast DDS then waits 100 ms for that reader and gives up;
 rclpy turns the failure into a RuntimeWarning and the response is lost: the client waits forever
 (ros2/ros2#1253). A late client is therefore answered again, a few times over a few seconds, by a
-thread of its own, and the log says so once per service when it never could be."""
+thread of its own, and the log says so once per service when it never could be. A response
+that cannot be sent at all is one log line: raised, it would end the executor's serving."""
 from __future__ import annotations
 
 import heapq
@@ -68,8 +69,11 @@ class LateResponses:
 
     def _sender(self, send: Callable[[Any, Any], None], name: str) -> Callable[[Any, Any], None]:
         def send_response(response: Any, header: Any) -> None:
-            if not delivered(send, response, header):
-                self._later(0, send, response, header, name)
+            try:
+                if not delivered(send, response, header):
+                    self._later(0, send, response, header, name)
+            except Exception as e:   # raised out of the executor, it would end the serving
+                self._log(f"a response to {name} could not be sent: {type(e).__name__}: {e}")
         return send_response
 
     def _later(self, attempt: int, send: Callable, response: Any, header: Any, name: str) -> None:

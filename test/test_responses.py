@@ -76,3 +76,15 @@ def test_other_warnings_are_still_shown(recwarn):
     LateResponses(print).serve([])
     warnings.warn("something else", UserWarning)
     assert [str(w.message) for w in recwarn] == ["something else"]
+
+
+def test_a_response_that_cannot_be_sent_is_one_log_line_not_an_exception():
+    class Broken(Service):
+        def send_response(self, response: str, header: str) -> None:
+            raise RuntimeError("failed to send response: rmw error")
+    log: list[str] = []
+    service = Broken(reachable_after=0)
+    LateResponses(log.append).serve([Node(service)])
+    service.send_response("a", "h")
+    assert log == ["a response to /node/op could not be sent: RuntimeError: failed to send "
+                   "response: rmw error"]
