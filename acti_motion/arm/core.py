@@ -153,6 +153,8 @@ def _first_exit(values: np.ndarray, lower: np.ndarray, upper: np.ndarray,
     """(sample, axis) where rows of `values` first go from inside [lower, upper] to outside,
     or where the last row is outside; None when the path stays (or ends) inside."""
     inside = (values >= lower - tol) & (values <= upper + tol)
+    if inside.all():                     # the usual case, at the least cost
+        return None
     exits = np.argwhere(inside[:-1] & ~inside[1:])
     if len(exits):
         k, axis = exits[0]
