@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import sys
 
-from acti_bringup.spinning import init
-from acti_bringup.view import ViewNode
+from acti_bringup.serving.spinning import init
+from acti_bringup.visual.view import ViewNode
 from acti_middle_node.node import ArmNode
 from vehicle_node.node import VehicleNode
 

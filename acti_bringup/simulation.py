@@ -18,12 +18,12 @@ from rclpy.publisher import Publisher
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
-from acti_bringup.camera import SimCamera
-from acti_bringup.parameters import declare_config
+from acti_bringup.visual.camera import SimCamera
+from acti_bringup.serving.parameters import declare_config
 from acti_bringup.priority import (FIFO_RANGE, NICE_RANGE, check_fifo_priority, freeze_heap,
                                    set_fifo, set_niceness)
-from acti_bringup.robot_graph import RobotGraph
-from acti_bringup.spinning import Planes, init, wait_for_signal
+from acti_bringup.visual.robot_graph import RobotGraph
+from acti_bringup.serving.spinning import Planes, init, wait_for_signal
 from acti_motion.executor import MotionExecutor
 from acti_sim.world import World
 
@@ -113,7 +113,7 @@ class Simulation:
     def spin(self, *nodes: Node) -> None:
         """Run the simulation and serve the nodes until SIGINT/SIGTERM, then clean up: each node
         on the control plane, its `motion` and `goals` plane nodes (a device node has them) on
-        theirs (`acti_bringup.spinning`)."""
+        theirs (`acti_bringup.serving.spinning`)."""
         planes = Planes()
         planes.add("control", nodes)
         helpers = [getattr(n, plane) for plane in ("motion", "goals") for n in nodes

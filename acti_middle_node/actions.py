@@ -1,7 +1,7 @@
 """The arm's completion paths: ~/wait_motion (wait for any queued motion) and ~/move (one move,
 answered when it is over). Both report progress as feedback and can be canceled.
 
-Goals await on the goal plane without holding its thread (`acti_bringup.waiting`); the goals of
+Goals await on the goal plane without holding its thread (`acti_bringup.serving.waiting`); the goals of
 both running at once are bounded (`max_action_goals`) and more are rejected.
 """
 from __future__ import annotations
@@ -13,9 +13,9 @@ from acti_msgs.action import Move, WaitMotion
 from acti_msgs.msg import ReturnId
 from rclpy.action import ActionServer
 
-from acti_bringup.adapter import Plane
-from acti_bringup.conversions import fill, to_core
-from acti_bringup.waiting import GoalSlots, accept_cancel, device_watch, wait_for_motion
+from acti_bringup.serving.adapter import Plane
+from acti_bringup.serving.conversions import fill, to_core
+from acti_bringup.serving.waiting import GoalSlots, accept_cancel, device_watch, wait_for_motion
 from acti_motion.arm.core import ArmCore
 from acti_motion.replies import Reply, ReturnCode
 

@@ -9,8 +9,8 @@ import pinocchio as pin
 from acti_msgs.msg import Alarm, ArmState, ReturnId
 from rclpy.node import Node
 
-from acti_bringup.adapter import Plane, serve_operations
-from acti_bringup.parameters import Setting, declare_config, sync_parameters
+from acti_bringup.serving.adapter import Plane, serve_operations
+from acti_bringup.serving.parameters import Setting, declare_config, sync_parameters
 from acti_bringup.simulation import Simulation
 from acti_middle_node.actions import ActionConfig, MotionActions
 from acti_middle_node.operations import OPERATIONS

@@ -2,7 +2,7 @@
 (in the spec's order), then the 2014 revision's extensions."""
 from acti_msgs import srv
 
-from acti_bringup.adapter import Operation
+from acti_bringup.serving.adapter import Operation
 
 COMMON_PORT: tuple[Operation, ...] = (
     Operation("clear_alarms", srv.ClearAlarms),

@@ -3,7 +3,7 @@ progress as feedback; canceling stops the program and the arm.
 
 The program runs on a thread of its own (`acti_motion.programs.run.ProgramRun`), never on an
 executor's thread; the goal's coroutine awaits its end on the goal plane without holding that
-thread (`acti_bringup.waiting.Watch`) and publishes feedback meanwhile, while the control plane
+thread (`acti_bringup.serving.waiting.Watch`) and publishes feedback meanwhile, while the control plane
 serves stop, pause, resume and get_state. One program runs at a time. The robot's
 digital I/O (`RobotIO`) lives as long as the node: outputs keep their values from run to run.
 """
@@ -16,9 +16,9 @@ from typing import Any
 from acti_msgs.action import RunProgram
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 
-from acti_bringup.adapter import Plane
-from acti_bringup.conversions import fill
-from acti_bringup.waiting import Watch
+from acti_bringup.serving.adapter import Plane
+from acti_bringup.serving.conversions import fill
+from acti_bringup.serving.waiting import Watch
 from acti_motion.arm.core import ArmCore
 from acti_motion.programs.run import ProgramRun, Status
 from acti_motion.programs.robot import ProgramDefaults, RobotIO

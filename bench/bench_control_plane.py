@@ -38,7 +38,7 @@ from action_msgs.msg import GoalStatus, GoalStatusArray
 from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosgraph_msgs.msg import Clock
 
-from acti_bringup.spinning import init, stop_requested
+from acti_bringup.serving.spinning import init, stop_requested
 
 ARM, BASE = "/acti_middle_node/", "/vehicle_node/"
 TRIALS = 20

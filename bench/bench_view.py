@@ -15,7 +15,7 @@ import time
 import numpy as np
 from common import RosClient, running
 
-from acti_bringup.browser import open_browser
+from acti_bringup.visual.browser import open_browser
 from acti_msgs import srv
 from acti_msgs.msg import ArmState
 

@@ -1,6 +1,6 @@
 """Baseline for the round-trip benchmarks: a bare std_srvs/Trigger server, nothing behind it.
 
-Served the way the nodes serve their control plane (`acti_bringup.spinning`: an EventsExecutor
+Served the way the nodes serve their control plane (`acti_bringup.serving.spinning`: an EventsExecutor
 driven by a spin_once loop), so the ratio measures the nodes' own cost, not an executor choice:
 
     python -m bench.trigger_server [events|single|multi]
@@ -12,7 +12,7 @@ from rclpy.executors import MultiThreadedExecutor, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
 from std_srvs.srv import Trigger
 
-from acti_bringup.spinning import SpinLoop, init, wait_for_signal
+from acti_bringup.serving.spinning import SpinLoop, init, wait_for_signal
 
 EXECUTORS = {"events": EventsExecutor, "single": SingleThreadedExecutor,
              "multi": MultiThreadedExecutor}

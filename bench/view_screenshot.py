@@ -13,7 +13,7 @@ import sys
 from common import RosClient, running
 
 from acti_bringup.harness import wait_until
-from acti_bringup.browser import dismiss_notices, open_browser, robot_pixels, screenshot
+from acti_bringup.visual.browser import dismiss_notices, open_browser, robot_pixels, screenshot
 from acti_msgs import srv
 from acti_msgs.msg import VehiclePoint
 

@@ -10,7 +10,7 @@ from acti_msgs.msg import CartesianSpeed, LimitValue
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import DescribeParameters, GetParameters, ListParameters, SetParameters
 
-from acti_bringup.parameters import field_descriptions
+from acti_bringup.serving.parameters import field_descriptions
 from ros_harness import node_fixture, wait_until
 
 arm_node = node_fixture("acti_middle_node", "queue_size:=4")

@@ -1,8 +1,8 @@
-"""Core values → ROS messages (`acti_bringup.conversions.fill`): nested messages built once per
+"""Core values → ROS messages (`acti_bringup.serving.conversions.fill`): nested messages built once per
 value and shared, and a changed value built anew."""
 from acti_msgs.srv import GetFeedbackPosCartesian, GetSoftLimitJoint
 
-from acti_bringup.conversions import fill
+from acti_bringup.serving.conversions import fill
 
 LIMITS = [(170.0, -170.0), (120.0, -120.0)]
 

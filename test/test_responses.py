@@ -7,8 +7,8 @@ import threading
 import time
 import warnings
 
-from acti_bringup import responses
-from acti_bringup.responses import LateResponses
+from acti_bringup.serving import responses
+from acti_bringup.serving.responses import LateResponses
 
 
 class Service:

@@ -1,4 +1,4 @@
-"""The serving planes (`acti_bringup.spinning`) on rclpy's EventsExecutor, explicitly: a spin_once
+"""The serving planes (`acti_bringup.serving.spinning`) on rclpy's EventsExecutor, explicitly: a spin_once
 loop serves services and timers and ends at once when stopped; a guard condition is what the
 EventsExecutor cannot serve (why goals have a plane of their own); and every way of running the
 nodes ends cleanly on SIGINT and SIGTERM (exit 0, no traceback)."""
@@ -12,7 +12,7 @@ from acti_msgs.srv import GetState, VehicleGetState
 from rclpy.experimental import EventsExecutor
 from std_srvs.srv import Trigger
 
-from acti_bringup.spinning import SPIN_TIMEOUT_S, SpinLoop
+from acti_bringup.serving.spinning import SPIN_TIMEOUT_S, SpinLoop
 from ros_harness import NodeProcess, wait_until
 
 

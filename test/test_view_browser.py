@@ -9,7 +9,7 @@ from acti_msgs import srv
 from acti_msgs.msg import ArmState
 from sensor_msgs.msg import JointState
 
-from acti_bringup.browser import open_browser, robot_pixels, screenshot
+from acti_bringup.visual.browser import open_browser, robot_pixels, screenshot
 from ros_harness import node_fixture, wait_until
 
 robot = node_fixture("acti_bringup", "view_port:=0")

@@ -3,7 +3,7 @@ queued targets, panel), the buttons' control path, the PNG snapshot."""
 import numpy as np
 import pytest
 
-from acti_bringup import snapshot
+from acti_bringup.visual import snapshot
 from acti_bringup.harness import wait_until
 from acti_motion.arm.core import ArmConfig, ArmCore
 from acti_motion.executor import MotionExecutor

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import pytest
 
-from acti_bringup.waiting import device_watch, wait_for_motion
+from acti_bringup.serving.waiting import device_watch, wait_for_motion
 from acti_motion.executor import Device
 
 
@@ -97,7 +97,7 @@ def test_completed_motion_is_announced_by_the_device_at_once(wait):
 def test_goal_slots_reject_beyond_the_limit_and_free_a_slot_however_a_goal_ends(ros):
     from rclpy.action import GoalResponse
 
-    from acti_bringup.waiting import GoalSlots
+    from acti_bringup.serving.waiting import GoalSlots
     with pytest.raises(ValueError, match="max_goals must be >= 1"):
         GoalSlots(ros.node, 0, "max_goals")
     slots = GoalSlots(ros.node, 1, "max_goals")

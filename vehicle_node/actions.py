@@ -1,6 +1,6 @@
 """vehicle_node's completion path: ~/wait_motion waits for a motion a move service queued, with
 feedback (progress, queue, pose) and cancel. Goals await on the goal plane without holding its
-thread; at most `max_wait_goals` run at once, more are rejected (`acti_bringup.waiting`)."""
+thread; at most `max_wait_goals` run at once, more are rejected (`acti_bringup.serving.waiting`)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -9,9 +9,9 @@ from typing import Any
 from acti_msgs.action import VehicleWaitMotion
 from rclpy.action import ActionServer
 
-from acti_bringup.adapter import Plane
-from acti_bringup.conversions import fill
-from acti_bringup.waiting import GoalSlots, accept_cancel, device_watch, wait_for_motion
+from acti_bringup.serving.adapter import Plane
+from acti_bringup.serving.conversions import fill
+from acti_bringup.serving.waiting import GoalSlots, accept_cancel, device_watch, wait_for_motion
 from acti_motion.vehicle.core import VehicleCore
 
 

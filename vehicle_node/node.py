@@ -25,10 +25,10 @@ from rclpy.node import Node
 from sensor_msgs.msg import Joy
 from tf2_msgs.msg import TFMessage
 
-from acti_bringup.adapter import Plane, serve_operations
-from acti_bringup.parameters import declare_config
+from acti_bringup.serving.adapter import Plane, serve_operations
+from acti_bringup.serving.parameters import declare_config
 from acti_bringup.simulation import Simulation
-from acti_bringup.transforms import planar_transform, tf_publisher
+from acti_bringup.visual.transforms import planar_transform, tf_publisher
 from acti_motion.vehicle.paths import Odometry as WheelOdometry, Pose2D
 from acti_motion.replies import Reply
 from acti_motion.vehicle.core import VehicleConfig, VehicleCore

@@ -1,7 +1,7 @@
 """The operation table of the base: one row per VehicleService IDL operation (the IDL's order)."""
 from acti_msgs import srv
 
-from acti_bringup.adapter import Operation
+from acti_bringup.serving.adapter import Operation
 
 OPERATIONS: tuple[Operation, ...] = (
     Operation("clear_alarm", srv.VehicleClearAlarm),

@@ -12,8 +12,8 @@ from rclpy.node import Node
 from std_msgs.msg import String
 from tf2_msgs.msg import TFMessage
 
-from acti_bringup.parameters import declare_config
-from acti_bringup.transforms import LATCHED_QOS, link_transform, static_tf_publisher, tf_publisher
+from acti_bringup.serving.parameters import declare_config
+from acti_bringup.visual.transforms import LATCHED_QOS, link_transform, static_tf_publisher, tf_publisher
 from acti_motion.link_poses import LinkPoses, LinkTransform
 from acti_sim.world import World
 

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 from rclpy.node import Node
 
-from acti_bringup.parameters import declare_config
+from acti_bringup.serving.parameters import declare_config
 from acti_bringup.simulation import Simulation
 from acti_motion.arm.core import ArmCore
 from acti_motion.vehicle.core import VehicleCore

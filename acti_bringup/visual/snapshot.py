@@ -1,7 +1,7 @@
 """Render the robot to a PNG: a fresh world (no running job is touched) with the arm at its
 start posture, or at the joints given, after the physics settled.
 
-    python -m acti_bringup.snapshot OUT.png [--joints J1 … J7 (degree)] [--size W H]
+    python -m acti_bringup.visual.snapshot OUT.png [--joints J1 … J7 (degree)] [--size W H]
 """
 from __future__ import annotations
 

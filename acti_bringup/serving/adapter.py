@@ -1,7 +1,7 @@
 """Table-driven service registration: one row per IDL operation, one core method per row.
 
 Operations that plan a motion are served by the device's motion plane (a `Plane` node), every
-other one by the device node itself on the control plane (see `acti_bringup.spinning`): a move
+other one by the device node itself on the control plane (see `acti_bringup.serving.spinning`): a move
 planning for milliseconds never delays stop, pause or get_state. Clients see one node's services
 either way (`/<ns>/<node>/<operation>`).
 """
@@ -14,7 +14,7 @@ from typing import Any, Callable
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-from acti_bringup.conversions import fill, request_reader
+from acti_bringup.serving.conversions import fill, request_reader
 from acti_motion.replies import Reply, ReturnCode
 
 # Operations that queue or re-plan motion: move_*, the gripper's and home moves, the base's
@@ -35,7 +35,7 @@ class Operation:
 
 class Plane(Node):
     """A node that holds part of a device node's entities so that another executor serves them
-    (`acti_bringup.spinning`): "motion" (planning services, command topics) or "goals" (action
+    (`acti_bringup.serving.spinning`): "motion" (planning services, command topics) or "goals" (action
     servers). An implementation detail (hidden name, no parameters of its own): its services
     and actions are named under the device node."""
 

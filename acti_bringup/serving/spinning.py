@@ -7,7 +7,7 @@
 - The motion plane (the services that plan a move, cmd_vel/joy) runs on an `EventsExecutor` of
   its own: planning for ms there never delays the control plane.
 - The goal plane (the action servers) runs on a `SingleThreadedExecutor`: goals are coroutines
-  that await (`acti_bringup.waiting`), which the EventsExecutor would poll without pause.
+  that await (`acti_bringup.serving.waiting`), which the EventsExecutor would poll without pause.
 
 Each executor is driven by a `spin_once` loop (the EventsExecutor's `spin()` serves nothing in
 this rclpy and neither honours SIGINT); SIGINT and SIGTERM are handled here, on the main thread.
@@ -25,7 +25,7 @@ from rclpy.experimental import EventsExecutor
 from rclpy.logging import get_logger
 from rclpy.node import Node
 
-from acti_bringup.responses import LateResponses
+from acti_bringup.serving.responses import LateResponses
 
 SPIN_TIMEOUT_S = 0.5        # a loop's longest sleep: how soon it notices it should end
 SIGNALS = (signal.SIGINT, signal.SIGTERM)

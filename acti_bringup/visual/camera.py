@@ -25,8 +25,8 @@ from rclpy.node import Node
 from sensor_msgs.msg import CameraInfo, Image
 from tf2_msgs.msg import TFMessage
 
-from acti_bringup.parameters import declare_config
-from acti_bringup.transforms import link_transform, static_tf_publisher
+from acti_bringup.serving.parameters import declare_config
+from acti_bringup.visual.transforms import link_transform, static_tf_publisher
 from acti_motion.executor import MotionExecutor
 from acti_motion.link_poses import LinkTransform
 from acti_sim.world import World
