@@ -12,7 +12,7 @@ from acti_msgs.srv import GetState, VehicleGetState
 from rclpy.experimental import EventsExecutor
 from std_srvs.srv import Trigger
 
-from acti_bringup.serving.spinning import SPIN_TIMEOUT_S, SpinLoop
+from acti_bringup.serving.spinning import SPIN_TIMEOUT_S, Planes, SpinLoop
 from ros_harness import NodeProcess, wait_until
 
 
@@ -58,6 +58,31 @@ def test_a_guard_condition_is_refused_by_the_events_executor(ros, events_loop):
     loop.start()
     assert ros.spin_until(lambda: not loop.alive, 5.0)
     assert "Guard conditions not supported" in str(loop.error)
+
+
+def test_the_planes_resend_what_dds_could_not_deliver_on_every_service_they_serve(ros):
+    """Planes.add hands every service of a node (its own and rclpy's parameter services) to
+    LateResponses; the wrapped services answer over DDS as before."""
+    saved = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    node = ros.rclpy.create_node("planes_test")
+
+    def ping(_request, response):
+        response.success = True
+        return response
+    node.create_service(Trigger, "~/ping", ping)
+    planes = Planes()
+    try:
+        planes.add("control", [node])
+        senders = {s.service_name: s.send_response.__qualname__ for s in node.services}
+        assert "/planes_test/ping" in senders and "/planes_test/list_parameters" in senders
+        assert all(q.startswith("LateResponses._sender") for q in senders.values()), senders
+        planes.start()
+        assert ros.call(Trigger, "/planes_test/ping").success
+    finally:
+        planes.stop()
+        node.destroy_node()
+        for s, handler in saved.items():
+            signal.signal(s, handler)
 
 
 ARM_UP = (GetState, "/acti_middle_node/get_state")
