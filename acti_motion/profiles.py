@@ -1,6 +1,7 @@
 """Time profiles: the synchronized trapezoid that PTP moves and straight base moves share."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -18,11 +19,16 @@ class Trapezoid:
 
     @classmethod
     def for_axes(cls, distance: np.ndarray, max_speed: np.ndarray, ramp: float) -> "Trapezoid":
-        """Profile for axes moving `distance` at no more than `max_speed` each (same units)."""
-        distance = np.abs(np.asarray(distance, float))
-        if not np.any(distance > 0.0):
+        """Profile for axes moving `distance` at no more than `max_speed` each (same units; a
+        speed of 0 for an axis that moves takes for ever). Plain floats: for a handful of axes
+        numpy's per-call cost was most of a PTP accept's."""
+        d = np.asarray(distance, float).reshape(-1).tolist()
+        v = np.asarray(max_speed, float).reshape(-1).tolist()
+        if len(v) == 1:
+            v = v * len(d)
+        if not any(d):
             return cls(0.0, 0.0)
-        cruise = float(np.max(distance / np.asarray(max_speed, float)))
+        cruise = max(abs(a) / b if b else (math.inf if a else 0.0) for a, b in zip(d, v))
         return cls(max(cruise, ramp) + ramp, ramp)
 
     @property

@@ -717,8 +717,8 @@ class ArmCore:
         return _in_range(t, floor, MAX_ACCEL_TIME_S, "acl_time", "s")
 
     def _check_joint_target(self, goal_deg: np.ndarray, name: str) -> None:
-        lo, hi = self.soft_limit_joint[:, 0], self.soft_limit_joint[:, 1]
-        for i, (q, a, b) in enumerate(zip(goal_deg, lo, hi)):
+        lo, hi = self.soft_limit_joint[:, 0].tolist(), self.soft_limit_joint[:, 1].tolist()
+        for i, (q, a, b) in enumerate(zip(np.asarray(goal_deg, float).tolist(), lo, hi)):
             if not a - 1e-9 <= q <= b + 1e-9:
                 raise value_error(f"{name}: J{i + 1} = {q:g}° is outside the soft limit "
                                   f"[{a:g}, {b:g}]°")
@@ -785,9 +785,12 @@ class ArmCore:
             goal = goal_of(start)
             self._check_joint_target(np.degrees(goal), label)
             path = LinearJointPath(start.joints, goal)
-            steps = 1 + max(1, math.ceil(np.max(np.abs(np.degrees(path.delta)))))
-            ss = np.linspace(0.0, 1.0, steps)
-            positions = frames.tool_of(self.kin.flange_many(path.q0 + ss[:, None] * path.delta))
+            steps = 1 + max(1, math.ceil(max(map(abs, np.degrees(path.delta).tolist()))))
+            if steps == 2:              # a move of at most 1° per joint: its two ends
+                qs = np.array((path.q0, path.q0 + path.delta))
+            else:
+                qs = path.q0 + np.linspace(0.0, 1.0, steps)[:, None] * path.delta
+            positions = frames.tool_of(self.kin.flange_many(qs))
             self._check_cartesian_positions(positions[:, :3, 3] * 1000.0, label)
             timing = Trapezoid.for_axes(path.delta, speed, ramp)
             return ArmMotion(path, timing, start.finger, start.finger, ramp, "joint")
