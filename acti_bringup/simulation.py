@@ -23,7 +23,7 @@ from acti_bringup.serving.parameters import declare_config
 from acti_bringup.priority import (FIFO_RANGE, NICE_RANGE, check_fifo_priority, freeze_heap,
                                    set_fifo, set_niceness)
 from acti_bringup.visual.robot_graph import RobotGraph
-from acti_bringup.serving.spinning import Planes, init, wait_for_signal
+from acti_bringup.serving.spinning import Planes, build_or_exit, init, wait_for_signal
 from acti_motion.executor import MotionExecutor
 from acti_sim.world import World
 
@@ -139,5 +139,5 @@ class Simulation:
 def run_alone(node_class: type, args: list[str] | None = None) -> None:
     """`python -m <node>`: one node with a simulation of its own, until SIGINT/SIGTERM."""
     init(sys.argv if args is None else args)
-    node = node_class()
+    node = build_or_exit(node_class, node_class.__module__.split(".")[0])
     node.simulation.spin(node)

@@ -1,4 +1,5 @@
-"""The nodes' parameters over DDS: every one described; on acti_middle_node the settable ones take
+"""The nodes' parameters over DDS: every one described; an integer given at start-up for a double
+is that double; on acti_middle_node the settable ones take
 effect through the matching service's validation (seen by its getter) and refuse a bad value with
 the service's reason, read-only ones refuse every set; a change through a service shows in the
 parameter. vehicle_node's parameters are all read-only (none is settable yet)."""
@@ -13,7 +14,8 @@ from rcl_interfaces.srv import DescribeParameters, GetParameters, ListParameters
 from acti_bringup.serving.parameters import field_descriptions
 from ros_harness import node_fixture, wait_until
 
-arm_node = node_fixture("acti_middle_node", "queue_size:=4")
+# rate_hz and clock_rate_hz as integers, as a user types them: they mean 250.0 and 100.0
+arm_node = node_fixture("acti_middle_node", "queue_size:=4", "rate_hz:=250", "clock_rate_hz:=100")
 vehicle_node = node_fixture("vehicle_node")
 ARM = "/acti_middle_node/"
 BASE = "/vehicle_node/"
@@ -74,6 +76,13 @@ def test_every_parameter_has_a_description_and_says_whether_it_can_be_set(ros, a
         assert d.read_only == (d.name not in SETTABLE), d.name
     assert ranges["accel_time_joint"].floating_point_range[0].to_value == 10.0
     assert ranges["initial_speed_ratio"].integer_range[0].to_value == 100
+
+
+def test_an_integer_given_at_start_up_for_a_double_is_that_double(ros, arm_node):
+    """Was: `-p clock_rate_hz:=0` ended the node with a type error (a set at run time took it)."""
+    for name, x in (("rate_hz", 250.0), ("clock_rate_hz", 100.0)):
+        v = get_param(ros, name)
+        assert v.type == ParameterType.PARAMETER_DOUBLE and v.double_value == x, name
 
 
 def test_a_set_takes_effect_as_the_service_would(ros, arm_node):

@@ -1,7 +1,8 @@
 """The serving planes (`acti_bringup.serving.spinning`) on rclpy's EventsExecutor, explicitly: a spin_once
 loop serves services and timers and ends at once when stopped; a guard condition is what the
-EventsExecutor cannot serve (why goals have a plane of their own); and every way of running the
-nodes ends cleanly on SIGINT and SIGTERM (exit 0, no traceback)."""
+EventsExecutor cannot serve (why goals have a plane of their own); every way of running the
+nodes ends cleanly on SIGINT and SIGTERM (exit 0, no traceback), and a start-up setting they
+refuse ends them with one line and exit status 2."""
 from __future__ import annotations
 
 import signal
@@ -102,3 +103,20 @@ def test_the_nodes_end_cleanly_on_a_signal(ros, tmp_path, module, up, signum):
     finally:
         node.stop()
     assert "Traceback" not in node.log(), node.log()
+
+
+@pytest.mark.parametrize("module, param, words", [
+    ("vehicle_node", "rate_hz:=-1.0", "rate_hz and joint_state_rate_hz must be > 0"),
+    ("acti_middle_node", "nice:=-30", "nice"),
+    ("acti_bringup", "queue_size:=2.5", "queue_size")])
+def test_a_refused_start_up_setting_is_one_line_and_exit_status_2(tmp_path, module, param, words):
+    """Was: a traceback (and exit status 1) for a value out of range or of the wrong type."""
+    node = NodeProcess(module, str(tmp_path / "node.log"), param)
+    try:
+        assert node.proc.wait(timeout=60.0) == 2, node.log()
+    finally:
+        node.stop()
+    log = node.log()
+    fatal = [line for line in log.splitlines() if "[FATAL]" in line]
+    assert len(fatal) == 1 and "cannot start:" in fatal[0] and words in fatal[0], log
+    assert "Traceback" not in log, log

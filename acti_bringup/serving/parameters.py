@@ -38,6 +38,29 @@ class Setting:
     read: Callable[[], Any]
 
 
+def widened(p: Parameter, declared_type: int) -> Parameter:
+    """An integer given for a double (or integers for a double array) as the double(s) it means,
+    instead of a type error: `-p rate_hz:=250` and `ros2 param set … 250` mean 250.0."""
+    if declared_type == Parameter.Type.DOUBLE.value and p.type_ == Parameter.Type.INTEGER:
+        return Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
+    if declared_type == Parameter.Type.DOUBLE_ARRAY.value \
+            and p.type_ == Parameter.Type.INTEGER_ARRAY:
+        return Parameter(p.name, Parameter.Type.DOUBLE_ARRAY, [float(x) for x in p.value])
+    return p
+
+
+def _start_up_value(node: Node, name: str, declared: Any) -> tuple[Any, bool]:
+    """(value, True) when the start-up override of `name` (`--ros-args -p name:=…`, which rclpy
+    keeps in `_parameter_overrides`) is an integer for a double, as the double; else
+    (declared, False): rclpy applies the override itself."""
+    override = getattr(node, "_parameter_overrides", {}).get(name)
+    if override is None:
+        return declared, False
+    want = Parameter.Type.from_parameter_value(declared).value
+    wide = widened(override, want)
+    return (wide.value, True) if wide is not override else (declared, False)
+
+
 class _Parameters:
     """The settable parameters of one node and the callbacks that serve them."""
 
@@ -48,19 +71,9 @@ class _Parameters:
         node.add_on_set_parameters_callback(self._apply)
 
     def _widen_integers(self, parameters: list[Parameter]) -> list[Parameter]:
-        """`ros2 param set … max_speed_translation 250` means 250.0: integers given for a double
-        (or a double array) become doubles instead of a type error."""
-        out = []
-        for p in parameters:
-            want = (self.node.describe_parameter(p.name).type
-                    if self.node.has_parameter(p.name) else None)
-            if want == Parameter.Type.DOUBLE.value and p.type_ == Parameter.Type.INTEGER:
-                p = Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
-            elif want == Parameter.Type.DOUBLE_ARRAY.value \
-                    and p.type_ == Parameter.Type.INTEGER_ARRAY:
-                p = Parameter(p.name, Parameter.Type.DOUBLE_ARRAY, [float(x) for x in p.value])
-            out.append(p)
-        return out
+        """`ros2 param set … max_speed_translation 250` means 250.0 (see `widened`)."""
+        return [widened(p, self.node.describe_parameter(p.name).type)
+                if self.node.has_parameter(p.name) else p for p in parameters]
 
     def _apply(self, parameters: list[Parameter]) -> SetParametersResult:
         for p in parameters:
@@ -103,7 +116,8 @@ def declare_config(node: Node, config_type: type[C],
         default = getattr(defaults, f.name)
         declared = _as_parameter_value(default)
         descriptor = _descriptor(f, declared, notes.get(f.name, ""), f.name in settings)
-        value = node.declare_parameter(f.name, declared, descriptor).value
+        start, own = _start_up_value(node, f.name, declared)
+        value = node.declare_parameter(f.name, start, descriptor, ignore_override=own).value
         values[f.name] = tuple(value) if isinstance(default, tuple) else value
     if settings:
         _parameters_of(node).settings.update(settings)

@@ -16,9 +16,10 @@ from __future__ import annotations
 
 import signal
 import threading
-from typing import Callable, Iterable
+from typing import Callable, Iterable, TypeVar
 
 import rclpy
+from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.executors import Executor, SingleThreadedExecutor
 from rclpy.signals import SignalHandlerOptions
 from rclpy.experimental import EventsExecutor
@@ -27,6 +28,7 @@ from rclpy.node import Node
 
 from acti_bringup.serving.responses import LateResponses
 
+T = TypeVar("T")
 SPIN_TIMEOUT_S = 0.5        # a loop's longest sleep: how soon it notices it should end
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
 _stop_requested = threading.Event()
@@ -48,6 +50,18 @@ def init(args: list[str]) -> None:
     """rclpy.init with this module's signal handling instead of rclpy's."""
     catch_signals()
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+
+
+def build_or_exit(build: Callable[[], T], name: str) -> T:
+    """build() the process's nodes. A start-up setting they refuse (a parameter out of its range
+    or of the wrong type, settings that contradict each other) ends the process with one line that
+    says what, and exit status 2: a configuration error, not a traceback."""
+    try:
+        return build()
+    except (ValueError, InvalidParameterTypeException, InvalidParameterValueException) as e:
+        get_logger(name).fatal(f"cannot start: {e}")
+        rclpy.try_shutdown()
+        raise SystemExit(2) from None
 
 
 class SpinLoop:
