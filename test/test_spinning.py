@@ -105,18 +105,21 @@ def test_the_nodes_end_cleanly_on_a_signal(ros, tmp_path, module, up, signum):
     assert "Traceback" not in node.log(), node.log()
 
 
-@pytest.mark.parametrize("module, param, words", [
-    ("vehicle_node", "rate_hz:=-1.0", "rate_hz and joint_state_rate_hz must be > 0"),
-    ("acti_middle_node", "nice:=-30", "nice"),
-    ("acti_bringup", "queue_size:=2.5", "queue_size")])
-def test_a_refused_start_up_setting_is_one_line_and_exit_status_2(tmp_path, module, param, words):
-    """Was: a traceback (and exit status 1) for a value out of range or of the wrong type."""
-    node = NodeProcess(module, str(tmp_path / "node.log"), param)
+@pytest.mark.parametrize("module, param, namespace, words", [
+    ("vehicle_node", "rate_hz:=-1.0", "", "rate_hz and joint_state_rate_hz must be > 0"),
+    ("acti_middle_node", "nice:=-30", "", "nice"),
+    ("acti_bringup", "queue_size:=2.5", "", "queue_size"),
+    ("acti_bringup", "rate_hz:=250.0", "/robot-1", "Couldn't parse remap rule")])
+def test_a_refused_start_up_setting_is_one_line_and_exit_status_2(tmp_path, module, param,
+                                                                  namespace, words):
+    """Was: a traceback (and exit status 1) for a value out of range or of the wrong type, or a
+    namespace rcl cannot parse."""
+    node = NodeProcess(module, str(tmp_path / "node.log"), param, namespace=namespace)
     try:
         assert node.proc.wait(timeout=60.0) == 2, node.log()
     finally:
         node.stop()
     log = node.log()
     fatal = [line for line in log.splitlines() if "[FATAL]" in line]
-    assert len(fatal) == 1 and "cannot start:" in fatal[0] and words in fatal[0], log
+    assert len(fatal) == 1 and f"[{module}]: cannot start:" in fatal[0] and words in fatal[0], log
     assert "Traceback" not in log, log

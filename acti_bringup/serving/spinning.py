@@ -14,13 +14,16 @@ this rclpy and neither honours SIGINT); SIGINT and SIGTERM are handled here, on 
 """
 from __future__ import annotations
 
+import os
 import signal
+import sys
 import threading
-from typing import Callable, Iterable, TypeVar
+from typing import Callable, Iterable, NoReturn, TypeVar
 
 import rclpy
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.executors import Executor, SingleThreadedExecutor
+from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.signals import SignalHandlerOptions
 from rclpy.experimental import EventsExecutor
 from rclpy.logging import get_logger
@@ -28,6 +31,7 @@ from rclpy.node import Node
 
 from acti_bringup.serving.responses import LateResponses
 
+RCLError = rclpy_implementation.RCLError
 T = TypeVar("T")
 SPIN_TIMEOUT_S = 0.5        # a loop's longest sleep: how soon it notices it should end
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -47,9 +51,29 @@ def stop_requested() -> bool:
 
 
 def init(args: list[str]) -> None:
-    """rclpy.init with this module's signal handling instead of rclpy's."""
+    """rclpy.init with this module's signal handling instead of rclpy's. ROS arguments rcl
+    refuses (a remap it cannot parse, a parameters file it cannot read) end the process as a
+    refused setting does (`build_or_exit`)."""
     catch_signals()
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    try:
+        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    except RCLError as e:
+        _cannot_start(_program_name(), e)
+
+
+def _program_name() -> str:
+    """What was started: `acti_bringup` for `python -m acti_bringup`, else the script's name."""
+    spec = getattr(sys.modules["__main__"], "__spec__", None)
+    if spec is not None:
+        return spec.name.removesuffix(".__main__")
+    return os.path.basename(sys.argv[0]) if sys.argv and sys.argv[0] else "python"
+
+
+def _cannot_start(name: str, why: BaseException) -> NoReturn:
+    """One FATAL line that says why, exit status 2."""
+    get_logger(name).fatal(f"cannot start: {why}")
+    rclpy.try_shutdown()
+    raise SystemExit(2)
 
 
 def build_or_exit(build: Callable[[], T], name: str) -> T:
@@ -59,9 +83,7 @@ def build_or_exit(build: Callable[[], T], name: str) -> T:
     try:
         return build()
     except (ValueError, InvalidParameterTypeException, InvalidParameterValueException) as e:
-        get_logger(name).fatal(f"cannot start: {e}")
-        rclpy.try_shutdown()
-        raise SystemExit(2) from None
+        _cannot_start(name, e)
 
 
 class SpinLoop:
