@@ -48,6 +48,15 @@ def test_jog_refuses_bad_velocities(base, x_vel, y_vel, theta_vel, words):
     assert not r.ok and words in r.comment and base.device.last_id == 0
 
 
+def test_cmd_vel_clamps_to_the_limits_and_a_nan_is_no_velocity(base):
+    """Was: min/max turned a NaN of cmd_vel into full speed in reverse (-1000 mm/s)."""
+    limit_t, limit_r = base.config.velocity_limit_translation, base.config.velocity_limit_rotation
+    assert base.clamp_velocity(math.nan, 0.0) is None
+    assert base.clamp_velocity(0.0, math.nan) is None
+    assert base.clamp_velocity(100.0, -20.0) == (100.0, -20.0, False)
+    assert base.clamp_velocity(1e308, -math.inf) == (limit_t, -limit_r, True)
+
+
 def test_jog_needs_only_the_servo_and_takes_over_a_move(base, executor):  # noqa: F811
     r = base.move_jog(100.0, 0.0, 0.0)
     assert not r.ok and "Unpowered" in r.comment

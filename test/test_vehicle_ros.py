@@ -162,6 +162,31 @@ def test_cmd_vel_over_the_limit_is_clamped_and_said_once(ros, vehicle):
     assert vehicle.alive()
 
 
+def test_a_cmd_vel_that_is_not_finite_is_ignored_and_said(ros, vehicle):
+    """Was: a NaN linear.x drove the base backwards at full speed."""
+    got = []
+    sub = ros.node.create_subscription(Odometry, "/odom", got.append, 10)
+    cmd = ros.node.create_publisher(Twist, "/cmd_vel", 10)
+    try:
+        assert call(ros, "set_power", on_off=True).success and call(ros, "set_servo", on_off=True).success
+        assert wait_until(lambda: state(ros) == 0x010, 10.0)
+        assert ros.spin_until(lambda: got, 5.0)
+        for x, z in ((math.nan, 0.0), (0.2, math.inf), (-math.inf, math.nan)):
+            twist = Twist()
+            twist.linear.x, twist.angular.z = x, z
+            deadline = time.monotonic() + 0.5
+            while time.monotonic() < deadline:
+                cmd.publish(twist)
+                ros.executor.spin_once(timeout_sec=0.05)
+        assert wait_until(lambda: "cmd_vel ignored" in vehicle.log(), 5.0)
+        assert state(ros) == 0x010                                            # never Busy
+        assert max(abs(m.twist.twist.linear.x) for m in got) < 1e-3
+    finally:
+        ros.node.destroy_subscription(sub)
+        ros.node.destroy_publisher(cmd)
+    assert vehicle.alive()
+
+
 def test_joystick_over_the_joy_topic(ros, vehicle):
     from sensor_msgs.msg import Joy
     got = []

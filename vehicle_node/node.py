@@ -120,7 +120,14 @@ class VehicleNode(Node):
     # --- topics in ---------------------------------------------------------------------------
     def _on_cmd_vel(self, msg: Twist) -> None:
         """Clamp to the unit's limits, as ROS base drivers do (a differential drive ignores
-        linear.y); say so once."""
+        linear.y); say so once. A NaN or infinite linear.x or angular.z is no command: ignored,
+        so a running jog ends at its jog timeout, as when commands stop."""
+        if not (math.isfinite(msg.linear.x) and math.isfinite(msg.angular.z)):
+            self.get_logger().warn(
+                f"cmd_vel ignored: linear.x = {msg.linear.x} m/s, angular.z = {msg.angular.z} "
+                "rad/s must be finite (a running jog stops at its jog timeout)",
+                throttle_duration_sec=2.0)
+            return
         x, th, clamped = self.core.clamp_velocity(1000.0 * msg.linear.x, math.degrees(msg.angular.z))
         if (clamped or msg.linear.y != 0.0) and not self._cmd_vel_clamped:
             self._cmd_vel_clamped = True

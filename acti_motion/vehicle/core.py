@@ -478,13 +478,16 @@ class VehicleCore(Sensing):
         return self._drive((vx / 1000.0, math.radians(vth)), self.jog_timeout / 1000.0,
                            (at / 1000.0, math.radians(ar)), "move_jog", take_over=True)
 
-    def clamp_velocity(self, x_vel: float, theta_vel: float) -> tuple[float, float, bool]:
+    def clamp_velocity(self, x_vel: float, theta_vel: float) -> tuple[float, float, bool] | None:
         """(x_vel mm/s, theta_vel degree/s) clamped to the unit's limits, and whether they were:
-        cmd_vel is clamped, as ROS base drivers do, where move_jog refuses."""
+        cmd_vel is clamped, as ROS base drivers do, where move_jog refuses. None for a NaN, which
+        is no velocity at all (min and max would have made it full speed in reverse)."""
+        if math.isnan(x_vel) or math.isnan(theta_vel):
+            return None
         c = self.config
         x = min(c.velocity_limit_translation, max(-c.velocity_limit_translation, x_vel))
         th = min(c.velocity_limit_rotation, max(-c.velocity_limit_rotation, theta_vel))
-        return x, th, (x, th) != (x_vel, theta_vel) and math.isfinite(x_vel) and math.isfinite(theta_vel)
+        return x, th, (x, th) != (x_vel, theta_vel)
 
     @planned
     def set_joystick(self, on_off: bool) -> None:
