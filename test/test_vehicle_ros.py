@@ -2,6 +2,7 @@
 refusals that leave the node up."""
 import math
 import time
+from contextlib import contextmanager
 
 from acti_msgs import srv
 from acti_msgs.msg import VehicleAlarm, VehiclePoint, VehiclePosition, VehicleStatus, VehicleVelocity
@@ -139,52 +140,49 @@ def test_topics_state_diagnostics_odom_and_cmd_vel(ros, vehicle):
     assert vehicle.alive()
 
 
-def test_cmd_vel_over_the_limit_is_clamped_and_said_once(ros, vehicle):
+@contextmanager
+def cmd_vel_on_a_ready_base(ros, vehicle):
+    """(odometry received, send(x m/s, y m/s, z rad/s, seconds)): the base powered, servo on and
+    Ready; send publishes that Twist on /cmd_vel every 50 ms for `seconds`."""
     got = []
     sub = ros.node.create_subscription(Odometry, "/odom", got.append, 10)
     cmd = ros.node.create_publisher(Twist, "/cmd_vel", 10)
-    try:
-        assert call(ros, "set_power", on_off=True).success and call(ros, "set_servo", on_off=True).success
-        assert wait_until(lambda: state(ros) == 0x010, 10.0)
+
+    def send(x: float, y: float, z: float, seconds: float) -> None:
         twist = Twist()
-        twist.linear.x, twist.linear.y, twist.angular.z = 5.0, 0.3, -10.0     # m/s, rad/s
-        deadline = time.monotonic() + 1.0
+        twist.linear.x, twist.linear.y, twist.angular.z = x, y, z
+        deadline = time.monotonic() + seconds
         while time.monotonic() < deadline:
             cmd.publish(twist)
             ros.executor.spin_once(timeout_sec=0.05)
-        assert ros.spin_until(lambda: got and got[-1].twist.twist.linear.x > 0.3, 5.0)
-        assert max(m.twist.twist.linear.x for m in got) < 1.0 * 1.1            # the unit's limit
-        assert wait_until(lambda: state(ros) == 0x010, 10.0)                    # stops by itself
-        assert vehicle.log().count("cmd_vel is clamped") == 1
-    finally:
-        ros.node.destroy_subscription(sub)
-        ros.node.destroy_publisher(cmd)
-    assert vehicle.alive()
-
-
-def test_a_cmd_vel_that_is_not_finite_is_ignored_and_said(ros, vehicle):
-    """Was: a NaN linear.x drove the base backwards at full speed."""
-    got = []
-    sub = ros.node.create_subscription(Odometry, "/odom", got.append, 10)
-    cmd = ros.node.create_publisher(Twist, "/cmd_vel", 10)
     try:
         assert call(ros, "set_power", on_off=True).success and call(ros, "set_servo", on_off=True).success
         assert wait_until(lambda: state(ros) == 0x010, 10.0)
         assert ros.spin_until(lambda: got, 5.0)
-        for x, z in ((math.nan, 0.0), (0.2, math.inf), (-math.inf, math.nan)):
-            twist = Twist()
-            twist.linear.x, twist.angular.z = x, z
-            deadline = time.monotonic() + 0.5
-            while time.monotonic() < deadline:
-                cmd.publish(twist)
-                ros.executor.spin_once(timeout_sec=0.05)
-        assert wait_until(lambda: "cmd_vel ignored" in vehicle.log(), 5.0)
-        assert state(ros) == 0x010                                            # never Busy
-        assert max(abs(m.twist.twist.linear.x) for m in got) < 1e-3
+        yield got, send
     finally:
         ros.node.destroy_subscription(sub)
         ros.node.destroy_publisher(cmd)
     assert vehicle.alive()
+
+
+def test_cmd_vel_over_the_limit_is_clamped_and_said_once(ros, vehicle):
+    with cmd_vel_on_a_ready_base(ros, vehicle) as (got, send):
+        send(5.0, 0.3, -10.0, 1.0)                                              # m/s, rad/s
+        assert ros.spin_until(lambda: got[-1].twist.twist.linear.x > 0.3, 5.0)
+        assert max(m.twist.twist.linear.x for m in got) < 1.0 * 1.1            # the unit's limit
+        assert wait_until(lambda: state(ros) == 0x010, 10.0)                    # stops by itself
+        assert vehicle.log().count("cmd_vel is clamped") == 1
+
+
+def test_a_cmd_vel_that_is_not_finite_is_ignored_and_said(ros, vehicle):
+    """Was: a NaN linear.x drove the base backwards at full speed."""
+    with cmd_vel_on_a_ready_base(ros, vehicle) as (got, send):
+        for x, z in ((math.nan, 0.0), (0.2, math.inf), (-math.inf, math.nan)):
+            send(x, 0.0, z, 0.5)
+        assert wait_until(lambda: "cmd_vel ignored" in vehicle.log(), 5.0)
+        assert state(ros) == 0x010                                            # never Busy
+        assert max(abs(m.twist.twist.linear.x) for m in got) < 1e-3
 
 
 def test_joystick_over_the_joy_topic(ros, vehicle):
