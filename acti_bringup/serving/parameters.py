@@ -14,6 +14,7 @@ import ast
 import dataclasses
 import inspect
 import io
+import math
 import textwrap
 import tokenize
 from dataclasses import dataclass
@@ -47,6 +48,17 @@ def widened(p: Parameter, declared_type: int) -> Parameter:
             and p.type_ == Parameter.Type.INTEGER_ARRAY:
         return Parameter(p.name, Parameter.Type.DOUBLE_ARRAY, [float(x) for x in p.value])
     return p
+
+
+def _check_finite(name: str, value: Any) -> None:
+    """ValueError unless every number of a double (or double array) parameter is finite: no
+    setting of these nodes means anything at NaN or infinity, and comparisons let NaN through
+    (`rate_hz <= 0` is false for NaN)."""
+    numbers = value if isinstance(value, (list, tuple)) else [value]
+    bad = [x for x in numbers if isinstance(x, float) and not math.isfinite(x)]
+    if bad:
+        raise ValueError(f"{name} = {value if isinstance(value, float) else list(value)}: "
+                         "it must be finite")
 
 
 def _start_up_value(node: Node, name: str, declared: Any) -> tuple[Any, bool]:
@@ -118,6 +130,7 @@ def declare_config(node: Node, config_type: type[C],
         descriptor = _descriptor(f, declared, notes.get(f.name, ""), f.name in settings)
         start, own = _start_up_value(node, f.name, declared)
         value = node.declare_parameter(f.name, start, descriptor, ignore_override=own).value
+        _check_finite(f.name, value)
         values[f.name] = tuple(value) if isinstance(default, tuple) else value
     if settings:
         _parameters_of(node).settings.update(settings)
