@@ -109,7 +109,8 @@ def test_the_nodes_end_cleanly_on_a_signal(ros, tmp_path, module, up, signum):
     ("vehicle_node", "rate_hz:=-1.0", "", "rate_hz and joint_state_rate_hz must be > 0"),
     ("acti_middle_node", "nice:=-30", "", "nice"),
     ("acti_bringup", "queue_size:=2.5", "", "queue_size"),
-    ("vehicle_node", "battery_hysteresis:=.nan", "", "battery_hysteresis = nan: it must be finite"),
+    ("vehicle_node", "stuck_error:=.nan", "", "stuck_error = nan: it must be finite"),
+    ("vehicle_node", "accel_limit_translation:=10.0", "", "would take 100 s"),
     ("acti_bringup", "real_time_factor:=.inf", "", "real_time_factor = inf: it must be finite"),
     ("acti_bringup", "rate_hz:=250.0", "/robot-1", "Couldn't parse remap rule")])
 def test_a_refused_start_up_setting_is_one_line_and_exit_status_2(tmp_path, module, param,

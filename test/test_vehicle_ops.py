@@ -357,8 +357,19 @@ def test_pause_reports_busy_until_the_base_is_at_rest(base, executor, trace):  #
     trace.check()
 
 
-@pytest.mark.parametrize("config", [dict(default_velocity_translation=2000.0),
-                                    dict(default_accel_rotation=0.0), dict(jog_timeout=0)])
-def test_start_up_settings_outside_the_limits_are_rejected(executor, config):  # noqa: F811
-    with pytest.raises(ValueError, match="vehicle configuration"):
+@pytest.mark.parametrize("config, words", [
+    (dict(default_velocity_translation=2000.0), "default velocity"),
+    (dict(default_accel_rotation=0.0), "default acceleration"),
+    (dict(jog_timeout=0), "jog_timeout"),
+    # was accepted: a target anywhere in 1e300 mm, a stop that would take hours, a NaN charge
+    (dict(work_area=1e300), "work_area is 1e+300: it must be within 1 … 1e+06"),
+    (dict(accel_limit_translation=10.0, accel_min_translation=1.0, default_accel_translation=5.0),
+     "would take 100 s"),
+    (dict(velocity_limit_rotation=90.0, accel_limit_rotation=2.0, accel_min_rotation=1.0,
+          default_accel_rotation=1.0), "would take 45 s"),
+    (dict(battery_charge=math.nan), "battery_charge is nan"),
+])
+def test_start_up_settings_outside_the_limits_are_rejected(executor, config, words):  # noqa: F811
+    with pytest.raises(ValueError, match="vehicle configuration") as refused:
         VehicleCore(executor, VehicleConfig(**config))
+    assert words in str(refused.value)

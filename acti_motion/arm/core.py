@@ -15,13 +15,14 @@ from __future__ import annotations
 
 import math
 import threading
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from enum import IntEnum
 from functools import lru_cache
 from typing import Any, Callable
 
 import numpy as np
 
+from acti_motion.config_fields import ranged
 from acti_motion.executor import MotionExecutor
 from acti_motion.arm.kinematics import ArmKinematics, Unreachable, rotate_about
 from acti_motion.arm.poses import Frames, compose_relative, hg_to_pose, inverse, pose_to_hg
@@ -88,11 +89,6 @@ class Alarm:
         return (self.code, int(self.type), self.description)
 
 
-def _ranged(default: Any, lo: float, hi: float) -> Any:
-    """A config field with a range (the parameter's descriptor shows it)."""
-    return field(default=default, metadata={"range": (lo, hi)})
-
-
 @dataclass
 class ArmConfig:
     """Start-up settings of the arm (the node's parameters); units as on the services. The
@@ -100,19 +96,19 @@ class ArmConfig:
     # motion queue capacity (FULL_MOTION_QUEUE_ERR beyond)
     queue_size: int = 32
     # joint and Cartesian speed ratio at start-up [%] (the spec says 0)
-    initial_speed_ratio: int = _ranged(0, 0, 100)
+    initial_speed_ratio: int = ranged(0, 0, 100)
     # PTP accel/decel time [s] (set_accel_time_joint)
-    accel_time_joint: float = _ranged(0.3, 0.0, MAX_ACCEL_TIME_S)
+    accel_time_joint: float = ranged(0.3, 0.0, MAX_ACCEL_TIME_S)
     # minimum joint accel time [s]: joint accel limit = max speed / it (set_min_accel_time_joint)
-    min_accel_time_joint: float = _ranged(0.1, 0.0, MAX_ACCEL_TIME_S)
+    min_accel_time_joint: float = ranged(0.1, 0.0, MAX_ACCEL_TIME_S)
     # CP accel/decel time [s] (set_accel_time_cartesian)
-    accel_time_cartesian: float = _ranged(0.3, 0.0, MAX_ACCEL_TIME_S)
+    accel_time_cartesian: float = ranged(0.3, 0.0, MAX_ACCEL_TIME_S)
     # minimum CP accel time [s] (set_min_accel_time_cartesian)
-    min_accel_time_cartesian: float = _ranged(0.1, 0.0, MAX_ACCEL_TIME_S)
+    min_accel_time_cartesian: float = ranged(0.1, 0.0, MAX_ACCEL_TIME_S)
     # maximum CP speed [mm/s] (set_max_speed_cartesian)
-    max_speed_translation: float = _ranged(500.0, *SPEED_TRANSLATION_MM_S)
+    max_speed_translation: float = ranged(500.0, *SPEED_TRANSLATION_MM_S)
     # maximum CP rotation and elbow speed [degree/s] (set_max_speed_cartesian)
-    max_speed_rotation: float = _ranged(90.0, *SPEED_ROTATION_DEG_S)
+    max_speed_rotation: float = ranged(90.0, *SPEED_ROTATION_DEG_S)
     # gripper opening speed, both fingers [mm/s]
     gripper_speed: float = 100.0
     # Cartesian soft limits of the control point, robot frame [mm]: x lower, x upper, y lower,

@@ -16,7 +16,7 @@ from typing import Any, Callable
 from acti_motion.executor import STALE, Device, MotionExecutor
 from acti_motion.replies import Refused, Reply, finite_number
 from acti_motion.vehicle.alarms import AlarmCode, Alarms, AlarmType, Kind
-from acti_motion.vehicle.config import VehicleConfig
+from acti_motion.vehicle.config import VehicleConfig, check_config
 from acti_motion.vehicle.cruise import CruiseMotion, plan_curve, transition_to
 from acti_motion.vehicle.paths import (BrakeMotion, Odometry, Path, Pose2D, TrackedBaseMotion, arc,
                                        line, straight_to, turn, velocity_path)
@@ -47,6 +47,7 @@ class VehicleCore(Sensing):
 
     def __init__(self, executor: MotionExecutor, config: VehicleConfig | None = None) -> None:
         self.config = c = config or VehicleConfig()
+        check_config(c)
         world = executor.world
         self.lock = threading.RLock()
         self.planning = threading.RLock()
@@ -83,8 +84,6 @@ class VehicleCore(Sensing):
             raise ValueError(f"vehicle configuration: {r.comment}") from None
         if c.jog_timeout <= 0:
             raise ValueError(f"vehicle configuration: jog_timeout is {c.jog_timeout} ms, it must be > 0")
-        if not (c.work_area > 0 and c.turn_limit > 0):
-            raise ValueError("vehicle configuration: work_area and turn_limit must be > 0")
         self.jog_timeout = c.jog_timeout
         self.joystick = False
         self._dt = executor.dt
