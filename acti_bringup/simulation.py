@@ -8,7 +8,7 @@ time, joints and transforms in its namespace: /robotN/clock, /robotN/joint_state
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable
 
 import rclpy
@@ -24,28 +24,35 @@ from acti_bringup.priority import (FIFO_RANGE, NICE_RANGE, check_fifo_priority, 
                                    set_fifo, set_niceness)
 from acti_bringup.visual.robot_graph import RobotGraph
 from acti_bringup.serving.spinning import Planes, build_or_exit, init, wait_for_signal
+from acti_motion.config_fields import ranged
 from acti_motion.executor import MotionExecutor
 from acti_sim.world import World
 
 SWITCH_INTERVAL_S = 2e-4
+# control rates PyBullet's robot keeps stable (10 Hz: 100 ms steps) and the 2-core machine keeps
+# up with (2 kHz) [Hz]
+RATE_RANGE_HZ = (10.0, 2000.0)
 
 
 @dataclass
 class SimulationConfig:
-    rate_hz: float = 250.0              # physics and control rate [Hz] (250: a 4 ms cycle)
-    real_time_factor: float = 1.0       # simulated seconds per wall second (0: as fast as it can)
-    joint_state_rate_hz: float = 50.0   # joint_states (and the links' TF) publication rate [Hz]
+    # physics and control rate [Hz] (250: a 4 ms cycle)
+    rate_hz: float = ranged(250.0, *RATE_RANGE_HZ)
+    # simulated seconds per wall second (0: as fast as it can)
+    real_time_factor: float = ranged(1.0, 0.0, 100.0)
+    # joint_states (and the links' TF) publication rate [Hz]
+    joint_state_rate_hz: float = ranged(50.0, 0.1, RATE_RANGE_HZ[1])
     # rate of the simulated time on `clock` (/clock, or /<namespace>/clock) [Hz]; 0: not published
-    clock_rate_hz: float = 100.0
+    clock_rate_hz: float = ranged(100.0, 0.0, RATE_RANGE_HZ[1])
     # niceness of the process's threads, -20 … 19 (lower runs first: the control loop before
     # the clients on a busy machine); below 0 needs CAP_SYS_NICE (root), else it is kept as is
-    nice: int = field(default=-10, metadata={"range": NICE_RANGE})
+    nice: int = ranged(-10, *NICE_RANGE)
     # SCHED_FIFO priority of the simulation (control loop) thread, 1 … 99; 0 (the default):
     # ordinary scheduling. Opt-in: a loop that falls behind steps without sleeping, and at FIFO
     # it then keeps a core from every ordinary thread (two 4x-real-time jobs on a busy 2-core
     # machine starved a service call for 30 s). Needs CAP_SYS_NICE (root); not applied when
     # real_time_factor is 0
-    control_fifo_priority: int = field(default=0, metadata={"range": FIFO_RANGE})
+    control_fifo_priority: int = ranged(0, *FIFO_RANGE)
 
 
 def stamp(node_time: float) -> Time:
@@ -62,10 +69,6 @@ class Simulation:
         # interval bounds that wait (the default 5 ms would dominate every round trip).
         sys.setswitchinterval(SWITCH_INTERVAL_S)
         set_niceness(c.nice, node.get_logger().warning)
-        if c.rate_hz <= 0 or c.real_time_factor < 0 or c.joint_state_rate_hz <= 0 \
-                or c.clock_rate_hz < 0:
-            raise ValueError("rate_hz and joint_state_rate_hz must be > 0, real_time_factor and "
-                             "clock_rate_hz >= 0")
         check_fifo_priority(c.control_fifo_priority)       # here, not on the simulation thread
         self._log = node.get_logger()
         self.world = World(time_step=1.0 / c.rate_hz)

@@ -106,12 +106,13 @@ def test_the_nodes_end_cleanly_on_a_signal(ros, tmp_path, module, up, signum):
 
 
 @pytest.mark.parametrize("module, param, namespace, words", [
-    ("vehicle_node", "rate_hz:=-1.0", "", "rate_hz and joint_state_rate_hz must be > 0"),
+    ("vehicle_node", "rate_hz:=-1.0", "", "rate_hz out of range"),
     ("acti_middle_node", "nice:=-30", "", "nice"),
     ("acti_bringup", "queue_size:=2.5", "", "queue_size"),
     ("vehicle_node", "stuck_error:=.nan", "", "stuck_error = nan: it must be finite"),
     ("vehicle_node", "accel_limit_translation:=10.0", "", "would take 100 s"),
-    ("acti_bringup", "real_time_factor:=.inf", "", "real_time_factor = inf: it must be finite"),
+    ("acti_bringup", "initial_joints_deg:=[0.0,30.0,0.0,-60.0,0.0,.inf,0.0]", "",
+     "initial_joints_deg = [0.0, 30.0, 0.0, -60.0, 0.0, inf, 0.0]: it must be finite"),
     ("acti_bringup", "rate_hz:=250.0", "/robot-1", "Couldn't parse remap rule")])
 def test_a_refused_start_up_setting_is_one_line_and_exit_status_2(tmp_path, module, param,
                                                                   namespace, words):
