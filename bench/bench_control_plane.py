@@ -1,6 +1,7 @@
 """Stop always works: `stop`'s reply time and the time to rest of both devices of the main job
 while (a) a long move is being planned, (b) the queue is full, (c) the most action goals are
-held, (d) 8 client processes storm getters and moves; and the largest /clock gap during each.
+held, (d) 8 client processes storm getters and moves, (e) a STROLIC program computes without
+pause on the arm; and the largest /clock gap during each.
 
 Each trial starts a motion, loads the job, calls a bare std_srvs/Trigger (the baseline, same
 moment, same load) and then `stop`. Rest is when the stopped motion retires: when the job says
@@ -13,6 +14,7 @@ time + 2 control periods, /clock never silent for more than 2 control periods.
 
     python bench/bench_control_plane.py            (a few minutes)
     python bench/bench_control_plane.py --cases cd (only cases (c) and (d))
+    python bench/bench_control_plane.py --cases e  (only the program case)
     python bench/bench_control_plane.py --storm S  (one storm client for S seconds: used by (d))
 """
 from __future__ import annotations
@@ -32,7 +34,7 @@ from common import Actions, RosClient, bare_call, p, running
 
 import rclpy
 from acti_msgs import srv
-from acti_msgs.action import VehicleWaitMotion, WaitMotion
+from acti_msgs.action import RunProgram, VehicleWaitMotion, WaitMotion
 from acti_msgs.msg import CarPosWithElbow, VehiclePoint
 from action_msgs.msg import GoalStatus, GoalStatusArray
 from rclpy.qos import DurabilityPolicy, QoSProfile
@@ -260,6 +262,35 @@ def trial_figures(ros: RosClient, bg: Background, device: Device, load: Load, wa
             ros.wait(future, 30.0)
 
 
+# counts to 2e9 inside a function (branches act only in one): computation without a motion,
+# ~1.6 M instructions/s on the arm's program thread, each under the GIL, for ~20 minutes
+BUSY_PROGRAM = """
+.name i %1000
+.name count %1001
+VAR #i #count DCL
+#i I4:0 STORE
+#count FDEF Fn{
+top:
+  #i i INC STORE
+  i I4:2000000000 LT >top BRT
+  END
+}
+count
+"""
+
+
+@contextmanager
+def busy_program(ros: RosClient) -> Iterator[None]:
+    """A STROLIC program running on the arm for the whole case; canceled at its end."""
+    programs = Actions(ros, RunProgram, ARM + "run_program")
+    handle = programs.send(text=BUSY_PROGRAM)
+    try:
+        ros.spin_until(lambda: False, 1.0)      # the program runs
+        yield
+    finally:
+        programs.cancel(handle)
+
+
 @contextmanager
 def storm(seconds: float) -> Iterator[None]:
     procs = [subprocess.Popen([sys.executable, os.path.abspath(__file__), "--storm",
@@ -325,6 +356,7 @@ def scenarios(ros: RosClient, bg: Background,
         "(b) the queue full": (full_queue, nullcontext),
         "(c) the most action goals held": (most_goals, nullcontext),
         "(d) 8 clients storm getters and moves": (nothing, lambda: storm(seconds=600.0)),
+        "(e) a STROLIC program computes": (nothing, lambda: busy_program(ros)),
     }
 
 
