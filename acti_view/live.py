@@ -8,6 +8,7 @@ state; buttons from `controls.CONTROLS`.
 """
 from __future__ import annotations
 
+import socket
 import threading
 import time
 from collections import deque
@@ -28,6 +29,25 @@ PANEL_EVERY = 5               # frames between panel refreshes
 ORANGE, BLUE, GREEN, RED = (255, 128, 20), (40, 110, 230), (30, 170, 60), (220, 40, 40)
 
 
+def check_host(host: str) -> None:
+    """ValueError unless a server can listen on `host` here. Checked first: viser's server
+    thread fails on an address it cannot bind, and its start then waits for ever."""
+    try:
+        addresses = socket.getaddrinfo(host, 0, type=socket.SOCK_STREAM)
+    except (socket.gaierror, UnicodeError) as e:
+        raise ValueError(f"view_host {host!r} is no address: {e}") from None
+    problems = []
+    for family, kind, proto, _name, address in addresses:
+        with socket.socket(family, kind, proto) as s:
+            try:
+                s.bind(address)
+                return
+            except OSError as e:
+                problems.append(str(e))
+    raise ValueError(f"view_host {host!r} is not an address of this machine: "
+                     + "; ".join(dict.fromkeys(problems)))
+
+
 class LiveView:
     """A viser server showing the robot; `start` serves it, `close` ends it."""
 
@@ -38,6 +58,7 @@ class LiveView:
         self.cores = cores
         self.period = 1.0 / rate_hz
         self.log = log
+        check_host(host)
         self.server = viser.ViserServer(host=host, port=port, label="acti_ros2", verbose=False)
         self.server.initial_camera.position = (1.7, -1.8, 1.3)
         self.server.initial_camera.look_at = (0.2, 0.0, 0.5)

@@ -113,6 +113,7 @@ def test_the_nodes_end_cleanly_on_a_signal(ros, tmp_path, module, up, signum):
     ("vehicle_node", "accel_limit_translation:=10.0", "", "would take 100 s"),
     ("acti_bringup", "initial_joints_deg:=[0.0,30.0,0.0,-60.0,0.0,.inf,0.0]", "",
      "initial_joints_deg = [0.0, 30.0, 0.0, -60.0, 0.0, inf, 0.0]: it must be finite"),
+    ("acti_bringup", "view_host:=192.0.2.1", "", "is not an address of this machine"),
     ("acti_bringup", "rate_hz:=250.0", "/robot-1", "Couldn't parse remap rule")])
 def test_a_refused_start_up_setting_is_one_line_and_exit_status_2(tmp_path, module, param,
                                                                   namespace, words):

@@ -10,7 +10,7 @@ from acti_motion.executor import MotionExecutor
 from acti_motion.vehicle.core import VehicleCore
 from acti_sim.world import World
 from acti_view.controls import CONTROLS, press
-from acti_view.live import panel_text
+from acti_view.live import check_host, panel_text
 from acti_view.sample import Reader, WorldSampler, pose_matrix, state_words
 
 
@@ -154,3 +154,11 @@ def test_live_view_poses_the_robot_at_its_rate_for_a_connected_page(robot):
         view.close()
         executor.shutdown()
 
+
+@pytest.mark.parametrize("host, words", [("999.1.1.1", "is no address"),
+                                         ("192.0.2.1", "is not an address of this machine")])
+def test_a_host_the_view_cannot_listen_on_is_refused_before_serving(host, words):
+    """Was: viser's server thread failed to bind and the job waited for ever at start-up."""
+    with pytest.raises(ValueError, match=words):
+        check_host(host)
+    check_host("127.0.0.1")
