@@ -40,13 +40,19 @@ class IoModule:
 
     @classmethod
     def load(cls, path: str, sensors: dict[str, Callable[[], int]] | None = None) -> "IoModule":
-        with open(path or DEFAULT_IO_CONFIG) as f:
-            doc = yaml.safe_load(f) or {}
+        path = path or DEFAULT_IO_CONFIG
+        try:
+            with open(path) as f:
+                doc = yaml.safe_load(f) or {}
 
-        def ports(key: str) -> list[Port]:
-            return [Port(int(p["id"]), str(p.get("name", "")), str(p.get("source", "")),
-                         int(p.get("value", 0))) for p in doc.get(key, [])]
-        return cls(ports("inputs"), ports("outputs"), sensors)
+            def ports(key: str) -> list[Port]:
+                return [Port(int(p["id"]), str(p.get("name", "")), str(p.get("source", "")),
+                             int(p.get("value", 0))) for p in doc.get(key, [])]
+            inputs, outputs = ports("inputs"), ports("outputs")
+        except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError, AttributeError) as e:
+            raise ValueError(f"io_config {path}: not an I/O description "
+                             f"({type(e).__name__}: {e})") from None
+        return cls(inputs, outputs, sensors)
 
     def read(self, ioid: int) -> int | None:
         """The input's value, or None for an unknown id."""

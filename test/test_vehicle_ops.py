@@ -201,6 +201,20 @@ def test_io_module_from_its_config(base):
     assert base.get_input(3).values["input"] == 0                  # output 2 untouched
 
 
+@pytest.mark.parametrize("text, words", [
+    (None, "FileNotFoundError"), ("inputs:\n  - {name: x}\n", "KeyError: 'id'"),
+    ("inputs: [\n", "ParserError"), ("inputs: 7\n", "TypeError")])
+def test_an_io_config_that_cannot_be_read_is_a_clear_start_up_error(executor, tmp_path, text,
+                                                                    words):  # noqa: F811
+    """Was: a FileNotFoundError (or YAML error) traceback at start-up."""
+    path = tmp_path / "io.yaml"
+    if text is not None:
+        path.write_text(text)
+    with pytest.raises(ValueError, match=f"io_config {path}: not an I/O description") as refused:
+        VehicleCore(executor, VehicleConfig(io_config=str(path)))
+    assert words in str(refused.value)
+
+
 @pytest.mark.parametrize("ioid, words", [(0, "reserved"), (3, "not declared"), (99, "not declared")])
 def test_set_output_refuses_reserved_and_unknown_ids(base, ioid, words):
     r = base.set_output(ioid, 1, 1)
