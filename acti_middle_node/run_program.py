@@ -72,6 +72,9 @@ def run(args: argparse.Namespace) -> int:
     except StrolicError as error:
         print(f"{args.program}: {error.report()}", file=sys.stderr)
         return 2
+    except (OSError, UnicodeDecodeError) as error:     # no such file; a text form not in UTF-8
+        print(f"{args.program}: {error}", file=sys.stderr)
+        return 2
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)   # Ctrl-C: cancel, then report
     node = rclpy.create_node("run_program")
     client = ActionClient(node, RunProgram, f"{args.node.rstrip('/')}/run_program")

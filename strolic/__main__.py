@@ -73,7 +73,7 @@ def main(argv: list[str] | None = None) -> int:
     except StrolicError as error:
         print(error.report(), file=sys.stderr)
         return 1
-    except OSError as error:
+    except (OSError, UnicodeDecodeError) as error:     # no such file; a text form not in UTF-8
         print(f"strolic: {error}", file=sys.stderr)
         return 2
     return 0

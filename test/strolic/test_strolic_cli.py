@@ -94,6 +94,21 @@ def test_missing_file_is_reported_without_a_traceback(tmp_path: Path) -> None:
     assert result.returncode == 2 and "Traceback" not in result.stderr
 
 
+@pytest.mark.parametrize("command", [("strolic", "run"), ("acti_middle_node.run_program",)])
+@pytest.mark.parametrize("name, content", [("missing.sasm", None), ("latin1.sasm", b"\xff\xfe 1 2 ADD")])
+def test_a_program_file_that_cannot_be_read_is_one_line_and_status_2(tmp_path: Path, command,
+                                                                     name, content) -> None:
+    """Was: a UnicodeDecodeError traceback (both), a FileNotFoundError traceback (run_program).
+    Neither needs a node: the file is read before any ROS."""
+    path = tmp_path / name
+    if content is not None:
+        path.write_bytes(content)
+    result = subprocess.run([sys.executable, "-m", *command, str(path)], capture_output=True,
+                            text=True, timeout=60, cwd=ROOT)
+    assert result.returncode == 2 and "Traceback" not in result.stderr, result.stderr
+    assert result.stderr.strip().count("\n") == 0 and result.stderr.strip(), result.stderr
+
+
 def test_run_uses_the_directory_of_the_program_for_files(tmp_path: Path) -> None:
     (tmp_path / "file2.txt").write_text("41\n")
     program = tmp_path / "files.sasm"
