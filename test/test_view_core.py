@@ -104,10 +104,17 @@ def test_snapshot_writes_a_picture_of_the_robot(tmp_path):
     assert orange.sum() > 200, "no robot in the picture"
 
 
-def test_snapshot_refuses_joints_outside_the_limits(tmp_path, capsys):
-    with pytest.raises(SystemExit):
-        snapshot.main([str(tmp_path / "x.png"), "--joints", "500", "0", "0", "0", "0", "0", "0"])
-    assert "initial_joints_deg" in capsys.readouterr().err
+@pytest.mark.parametrize("args, folder, words", [
+    (["--joints", "500", "0", "0", "0", "0", "0", "0"], "", "initial_joints_deg"),
+    # were a ZeroDivisionError, a std::bad_alloc abort and a FileNotFoundError traceback
+    (["--size", "0", "0"], "", "--size 0 0: both must be positive"),
+    (["--size", "100000", "100000"], "", "at most 2073600 px"),
+    (["--size", "64", "48"], "no-such-folder", "cannot write")])
+def test_snapshot_refuses_what_it_cannot_do_with_one_line(tmp_path, capsys, args, folder, words):
+    with pytest.raises(SystemExit) as refused:
+        snapshot.main([str(tmp_path / folder / "x.png"), *args])
+    assert refused.value.code == 2
+    assert words in capsys.readouterr().err
 
 
 def test_live_view_poses_the_robot_at_its_rate_for_a_connected_page(robot):

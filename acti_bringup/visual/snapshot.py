@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 
+from acti_bringup.visual.camera import MAX_PIXELS
 from acti_motion.arm.core import ArmConfig, ArmCore
 from acti_motion.executor import MotionExecutor
 from acti_sim.world import World
@@ -22,6 +23,10 @@ def main(argv: list[str] | None = None) -> None:
                         default=ArmConfig().initial_joints_deg, help="arm joints [degree]")
     parser.add_argument("--size", type=int, nargs=2, default=(800, 600), metavar=("W", "H"))
     args = parser.parse_args(argv)
+    width, height = args.size
+    if not (0 < width and 0 < height and width * height <= MAX_PIXELS):
+        parser.error(f"--size {width} {height}: both must be positive, at most {MAX_PIXELS} px "
+                     "in all")
     world = World()
     try:
         executor = MotionExecutor(world, real_time_factor=0.0)
@@ -31,7 +36,10 @@ def main(argv: list[str] | None = None) -> None:
             parser.error(str(e))
         for _ in range(SETTLE_STEPS):
             executor.step()
-        write_png(world, args.out, *args.size)
+        try:
+            write_png(world, args.out, width, height)
+        except OSError as e:
+            parser.error(f"cannot write {args.out}: {e.strerror or e}")
     finally:
         world.close()
     print(f"wrote {args.out}")
