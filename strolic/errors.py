@@ -32,6 +32,7 @@ class ExceptionKind(enum.Enum):
     FILE_OUTSIDE = "file outside the program directory"
     CONVERSION_ERROR = "conversion error"
     DETECTION_WAITED = "an interrupt detection procedure waited"
+    MEMORY_EXHAUSTED = "not enough memory for the data"
     COMPUTER_ERROR = "other computer error"
     # robot-language exceptions (§9)
     OUT_OF_OPERATING_REGION = "outside the operating region"

@@ -12,6 +12,7 @@ from decimal import ROUND_HALF_UP, Context, Decimal
 from .codes import I2, I4, INT_BITS, R4, R8, Num, Str, make_number
 from .errors import ExceptionKind as K, StrolicError, fail
 from .literals import format_real32
+from .values import check_datum_size
 
 Scalar = Num | Str
 EXACT = Context(prec=1000)      # enough digits for every R8 with its places
@@ -184,6 +185,7 @@ def basic_encode(image: bytes, values: list[Scalar]) -> bytes:
     if values and not any(isinstance(item, Field) for item in items):
         raise conversion_error("the format string has no field for the data")
     out: list[str] = []
+    length = 0
     remaining = list(values)
     while True:
         for item in items:
@@ -193,6 +195,8 @@ def basic_encode(image: bytes, values: list[Scalar]) -> bytes:
                 out.append(item.format(remaining.pop(0)))
             else:
                 return "".join(out).encode("latin-1")
+            length += len(out[-1])
+            check_datum_size(length)
         if not remaining:
             return "".join(out).encode("latin-1")
 
@@ -287,6 +291,7 @@ def c_encode(template: bytes, values: list[Scalar]) -> bytes:
             out += text
         else:
             out += spec % argument
+        check_datum_size(len(out))
     return bytes(out)
 
 

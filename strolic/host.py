@@ -82,6 +82,9 @@ def inside(root: Path | None, name: str) -> Path:
     return target
 
 
+OUTPUT_ENTRY = 64     # bytes an entry of the output stream takes besides its data (SYNC's 2)
+
+
 class Host:
     """A host without robot or OS tasks; it keeps what the VM sends to the programming device,
     has digital I/O and communication ports in memory, and files in a program directory."""
@@ -101,6 +104,12 @@ class Host:
     # output stream and console (SYNC, RESULT, TRACE)
     def send(self, data: bytes) -> None:
         self.output.append(data)
+
+    def memory_in_use(self) -> int:
+        """Bytes the host keeps for the program (output stream, port buffers): counted against
+        the VM's ``memory_limit``."""
+        return (sum(len(data) + OUTPUT_ENTRY for data in self.output)
+                + sum(map(len, self.port_buffers.values())))
 
     def console(self, text: str) -> None:
         print(text, file=sys.stderr)

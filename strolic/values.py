@@ -58,6 +58,15 @@ def decode_number_data(tag: int, data: bytes, offset: int = 0) -> Num:
 
 
 MAX_NESTING = 64     # array heads in array heads, function data in function data
+MAX_DATUM = 1 << 24  # bytes of the data part of one datum made at run time (the default heap)
+
+
+def check_datum_size(size: int) -> None:
+    """A function is about to make a datum of ``size`` bytes (CONC, CONSA, ENCODE1 …): one
+    longer than the whole heap is refused before it is made, so doubling a string cannot
+    take the machine's memory."""
+    if size > MAX_DATUM:
+        raise fail(K.MEMORY_EXHAUSTED, f"a datum of {size} bytes (at most {MAX_DATUM})")
 
 
 class Reader:

@@ -8,12 +8,13 @@ from __future__ import annotations
 
 from . import opcodes
 from .codec import CodeKind, decode, decode_function
-from .codes import Function, Num, UserCode, is_user_code, user_code_of, user_key
+from .codes import DATA_TYPES, Function, Num, UserCode, is_user_code, user_code_of, user_key
 from .errors import ExceptionKind as K, StrolicError, fail
 from .host import Host
 from .interrupts import Interrupts
 from .process import (BUILTIN, CYCLE_WAIT, INDIRECT, PUSH, USER, WAIT, Frame, Process,
                       State)
+from .values import check_datum_size, data_of
 from .variables import Scope, find
 
 SLICE = 200              # instructions a process runs before the scheduler looks again
@@ -26,12 +27,14 @@ class VM:
 
     def __init__(self, host: Host | None = None, *, max_stack: int = 100_000,
                  max_return_depth: int = 10_000, max_nesting: int = 32,
-                 heap_limit: int = 1 << 24) -> None:
+                 heap_limit: int = 1 << 24, memory_limit: int = 1 << 27) -> None:
         self.host = host or Host()
         self.max_stack = max_stack
         self.max_return_depth = max_return_depth
         self.max_nesting = max_nesting
         self.heap_limit = heap_limit
+        self.memory_limit = memory_limit   # bytes of data held at once (stacks, heap, output)
+        self.made = 0                      # bytes of data made since memory was last measured
         self._compiled: dict[bytes, list] = {}
         self.generation = 0                # bumped whenever waiting processes may proceed
         self.executed = 0                  # instructions of the current run (budget)
@@ -85,6 +88,32 @@ class VM:
         proc.wake_at = min(end, now + poll) if poll is not None else end
         return WAIT
 
+    # ---- memory ---------------------------------------------------------------------------------
+    def heap_in_use(self) -> int:
+        """Bytes of the registrations of every scope, shadowed ones included (choice 24)."""
+        scopes = [self.globals] + [s for p in self.processes.values() for s in p.scopes[1:]]
+        return sum(b.size() or 0 for s in scopes for stack in s.table.values() for b in stack)
+
+    def memory_in_use(self) -> int:
+        """Bytes of data held: the data stacks (a datum shared by DUP counted once), the heap,
+        and what the host keeps for the program."""
+        held = {id(item): item for p in self.processes.values() for item in p.stack
+                if isinstance(item, DATA_TYPES)}
+        return (sum(len(data_of(item)) for item in held.values()) + self.heap_in_use()
+                + self.host.memory_in_use())
+
+    def claim(self, size: int) -> None:
+        """A function makes a datum of ``size`` bytes: refused when the data held would pass
+        ``memory_limit`` (a loop piling up copies of a large string). What is held is measured
+        only when the bytes made since the last measurement could pass the limit."""
+        check_datum_size(size)
+        self.made += size
+        if self.made > self.memory_limit:
+            self.made = self.memory_in_use() + size
+            if self.made > self.memory_limit:
+                raise fail(K.MEMORY_EXHAUSTED, f"{self.made} bytes of data would be held "
+                                               f"(at most {self.memory_limit})")
+
     def scopes_for_new_process(self) -> list[Scope]:
         return [self.globals]
 
@@ -125,6 +154,7 @@ class VM:
         self.processes = {0: main}
         self.budget = budget
         self.executed = 0
+        self.made = 0
         try:
             while main.state is not State.DONE:
                 self.interrupts.poll(self)

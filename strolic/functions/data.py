@@ -71,6 +71,12 @@ def _area_slice(binding, start: int, size: int) -> bytearray:
     return area
 
 
+def written(vm: VM, binding, area: bytearray) -> None:
+    """After a write the next read makes a new value of the area's size (memory_limit)."""
+    vm.claim(len(area))
+    binding.written()
+
+
 def extb(vm: VM, proc: Process) -> None:
     """EXTB #a b #c: the bytes for type c at offset b, tagged c."""
     head = pop_head(proc)
@@ -88,7 +94,7 @@ def embb(vm: VM, proc: Process) -> None:
     binding = binding_of(proc, pop_user(proc))
     area = _area_slice(binding, start, len(data))
     area[start:start + len(data)] = data
-    binding.written()
+    written(vm, binding, area)
 
 
 # ---- elements -----------------------------------------------------------------------------------
@@ -129,7 +135,7 @@ def embe(vm: VM, proc: Process) -> None:
         data = data_of(wrap_int(I1, integer_value(numeric(value))))
     area = _area_slice(binding, index * size, size)
     area[index * size:index * size + size] = data
-    binding.written()
+    written(vm, binding, area)
 
 
 def numeric(value) -> Num:
@@ -157,8 +163,9 @@ def consa(vm: VM, proc: Process) -> None:
     count = pop_count(proc)
     if head.tag in (SUPPRESS, INDIRECT):
         raise fail(K.TYPE_MISMATCH, "array elements must be data")
-    elements = pop_many(proc, count)
-    proc.push(Array(head, b"".join(data_of(convert_element(e, head)) for e in elements)))
+    elements = [data_of(convert_element(e, head)) for e in pop_many(proc, count)]
+    vm.claim(sum(map(len, elements)))
+    proc.push(Array(head, b"".join(elements)))
 
 
 def desta(vm: VM, proc: Process) -> None:
@@ -180,11 +187,6 @@ def destu(vm: VM, proc: Process) -> None:
 
 
 # ---- heap areas ---------------------------------------------------------------------------------
-def _heap_in_use(vm) -> int:
-    scopes = [vm.globals] + [s for p in vm.processes.values() for s in p.scopes[1:]]
-    return sum(b.size() or 0 for s in scopes for stack in s.table.values() for b in stack)
-
-
 def alloc(vm: VM, proc: Process) -> None:
     """ALLOC and ALLOCZ a #b #c (EF67, EF68): an area of a bytes plus the tag b, which is
     written into it, for c; d is the size of the area (tag included). a ≤ 0 asks the largest
@@ -194,7 +196,7 @@ def alloc(vm: VM, proc: Process) -> None:
     head = pop_head(proc)
     size = pop_count(proc)
     binding = binding_of(proc, target)
-    free_bytes = vm.heap_limit - _heap_in_use(vm)
+    free_bytes = vm.heap_limit - vm.heap_in_use()
     if size <= 0:
         proc.push(smallest_int(free_bytes))
         return
@@ -215,7 +217,7 @@ def aclr(vm: VM, proc: Process) -> None:
     if binding.defined:
         area = binding.bytes_area()
         area[:] = bytes(len(area))
-        binding.written()
+        written(vm, binding, area)
 
 
 def arels(vm: VM, proc: Process) -> None:

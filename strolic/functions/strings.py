@@ -14,6 +14,7 @@ if TYPE_CHECKING:
 def conc(vm: VM, proc: Process) -> None:
     b = pop_of(proc, Str, "a string")
     a = pop_of(proc, Str, "a string")
+    vm.claim(len(a.data) + len(b.data))
     proc.push(Str(a.data + b.data))
 
 

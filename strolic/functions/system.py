@@ -6,6 +6,7 @@ from typing import TYPE_CHECKING
 from .. import literals
 from ..codes import ACK_CODE, DATA_TYPES, Str
 from ..errors import ExceptionKind as K, fail
+from ..host import OUTPUT_ENTRY
 from ..process import Process, State
 from ..values import encode_value
 
@@ -57,9 +58,15 @@ def trace(vm: VM, proc: Process) -> None:
         vm.host.console(f"TRACE {literals.format_value(item)}")
 
 
+def send(vm: VM, data: bytes) -> None:
+    """To the output stream, which the host keeps (memory_limit)."""
+    vm.claim(len(data) + OUTPUT_ENTRY)
+    vm.host.send(data)
+
+
 def sync(vm: VM, proc: Process) -> None:
     """SYNC: this VM is always in a normal state, so the answer is ACK."""
-    vm.host.send(ACK_CODE.to_bytes(2, "big"))
+    send(vm, ACK_CODE.to_bytes(2, "big"))
 
 
 def reply_code(vm: VM, proc: Process) -> None:
@@ -71,4 +78,4 @@ def result(vm: VM, proc: Process) -> None:
     value = proc.pop()
     if not isinstance(value, DATA_TYPES):
         raise fail(K.TYPE_MISMATCH, "RESULT sends data only")
-    vm.host.send(encode_value(value))
+    send(vm, encode_value(value))

@@ -142,7 +142,10 @@ def writer(end: bytes):
     """OUTPUT (an item and a blank), LOUTPUT (an item and a line feed)."""
     def handler(vm: VM, proc: Process) -> None:
         value = proc.pop()
-        _open_file(vm, proc).write(text_of(value) + end)
+        file = _open_file(vm, proc)
+        text = text_of(value) + end
+        vm.claim(len(text))           # a communication port keeps it in memory
+        file.write(text)
     return handler
 
 

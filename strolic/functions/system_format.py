@@ -128,7 +128,9 @@ def _pop_data(proc: Process) -> tuple[bytes, list]:
 def encoder(convert):
     """ENCODE1 (BASIC image), ENCODE2 (C format): a b1 … bn n → the string."""
     def handler(vm: VM, proc: Process) -> None:
-        proc.push(Str(convert(*_pop_data(proc))))
+        text = convert(*_pop_data(proc))
+        vm.claim(len(text))
+        proc.push(Str(text))
     return handler
 
 

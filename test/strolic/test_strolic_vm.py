@@ -48,6 +48,27 @@ def test_data_stack_and_return_stack_overflow() -> None:
     assert error_of("#f Fn{ f END } STORE f", max_return_depth=50).kind is K.STACK_OVERFLOW
 
 
+DOUBLINGS = " ".join(["DUP CONC"] * 28)           # 8 bytes → 2 GiB in 28 instructions
+
+
+@pytest.mark.parametrize("program", [
+    f'"AAAAAAAA" {DOUBLINGS}',                                     # one datum too long
+    '"AAAAAAAA" ' + " ".join(["DUP CONC"] * 20) + " DUP DUP DUP 4 #St(8388608) CONSA",
+    '"%65535d" ' + " ".join(["DUP CONC"] * 8) + ' "%65535d" CONC ' + "1 " * 257
+    + "I2:257 ENCODE2",                                            # 257 fields of 65535
+])
+def test_a_datum_longer_than_the_heap_is_refused_before_it_is_made(program: str) -> None:
+    assert error_of(program).kind is K.MEMORY_EXHAUSTED
+
+
+@pytest.mark.parametrize("step", ['s "x" CONC', "s RESULT", "SYNC", "101 s OUTPUT",
+                                  '#s 0 "x" EMBB s'])
+def test_data_piled_up_by_a_loop_is_bounded_by_the_memory_limit(step: str) -> None:
+    program = (f'.name s %1005 VAR #s DCL #s "{"A" * 1000}" STORE 101 2 FOPEN '
+               f"#f Fn{{ top: {step} >top BRA END }} STORE f")
+    assert error_of(program, budget=None, memory_limit=100_000).kind is K.MEMORY_EXHAUSTED
+
+
 def test_recursion_with_a_branch() -> None:
     factorial = ("#f Fn{ DUP 1 GT >rec BRT RET rec: DUP DEC f MUL END } STORE I4:10 f")
     assert stack_of(factorial) == ["3628800"]
