@@ -7,6 +7,7 @@ The subset of the BASIC image that is implemented is written down in README.md (
 from __future__ import annotations
 
 import re
+from collections import deque
 from decimal import ROUND_HALF_UP, Context, Decimal
 
 from .codes import I2, I4, INT_BITS, R4, R8, Num, Str, make_number
@@ -186,13 +187,13 @@ def basic_encode(image: bytes, values: list[Scalar]) -> bytes:
         raise conversion_error("the format string has no field for the data")
     out: list[str] = []
     length = 0
-    remaining = list(values)
+    remaining = deque(values)
     while True:
         for item in items:
             if isinstance(item, bytes):
                 out.append(item.decode("latin-1"))
             elif remaining:
-                out.append(item.format(remaining.pop(0)))
+                out.append(item.format(remaining.popleft()))
             else:
                 return "".join(out).encode("latin-1")
             length += len(out[-1])
@@ -248,12 +249,12 @@ def _c_argument(conversion: bytes, value: Scalar):
 def c_encode(template: bytes, values: list[Scalar]) -> bytes:
     """ENCODE2: ``sprintf``; extra data are ignored, too few are a conversion error."""
     out = bytearray()
-    remaining = list(values)
+    remaining = deque(values)
 
     def take(what: str) -> Scalar:
         if not remaining:
             raise conversion_error(f"no datum left for {what}")
-        return remaining.pop(0)
+        return remaining.popleft()
 
     i = 0
     while i < len(template):

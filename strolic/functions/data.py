@@ -170,7 +170,11 @@ def consa(vm: VM, proc: Process) -> None:
 
 def desta(vm: VM, proc: Process) -> None:
     """DESTA: the elements from the smallest subscript, then their count (smallest integer type)."""
-    elements = array_elements(pop_of(proc, Array, "an array"))
+    array = pop_of(proc, Array, "an array")
+    count = len(array.data) // (array.element.element_size() or 1)
+    if len(proc.stack) + count + 1 > vm.max_stack:      # checked before millions are made
+        raise fail(K.STACK_OVERFLOW, f"{count} elements do not fit the data stack")
+    elements = array_elements(array)
     proc.stack.extend(elements)
     proc.push(smallest_int(len(elements)))
 

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 from ..codes import (ARRAY, I2, NUMERIC_TAGS, POSE, R4, R8, RECORD, STRING, TAG_NAMES, TRANSFORM,
                      VECTOR, Array, Num, Pose, Record, Str, TagHead, Trn, UserCode, Vec,
                      make_number, round_half_away, type_name, user_key)
-from ..errors import StrolicError
+from ..errors import ExceptionKind as K, StrolicError, fail
 from ..formatting import assignments, basic_encode, c_decode, c_encode, conversion_error
 from ..literals import format_head
 from ..process import Process
@@ -101,10 +101,15 @@ def decode1(vm: VM, proc: Process) -> None:
 
 
 # ---- data → text (ENCODE1, ENCODE2), text → variables (DECODE2) ----------------------------------
-def scalars(items: list) -> list:
-    """The data as numbers and strings: Vec, Trn, Pm and arrays give their elements in order."""
+def scalars(items: list, limit: int) -> list:
+    """The data as numbers and strings: Vec, Trn, Pm and arrays give their elements in order;
+    at most ``limit`` of them (the data stack's), counted before an array is expanded, so that
+    an array of millions of bytes does not become millions of numbers."""
     out = []
     for item in items:
+        if isinstance(item, Array) and len(out) + len(item.data) // (
+                item.element.element_size() or 1) > limit:
+            raise fail(K.STACK_OVERFLOW, f"the data give more than {limit} numbers and strings")
         if isinstance(item, (Num, Str)):
             out.append(item)
         elif isinstance(item, (Vec, Trn)):
@@ -112,23 +117,23 @@ def scalars(items: list) -> list:
         elif isinstance(item, Pose):
             out.extend(item.elements)
         elif isinstance(item, Array):
-            out.extend(scalars(array_elements(item)))
+            out.extend(scalars(array_elements(item), limit - len(out)))
         else:
             raise conversion_error(f"{type_name(item)} cannot be converted to text")
     return out
 
 
-def _pop_data(proc: Process) -> tuple[bytes, list]:
+def _pop_data(vm: VM, proc: Process) -> tuple[bytes, list]:
     """a b1 … bn n: the format string and the data (numbers and strings)."""
     items = pop_many(proc, pop_count(proc))
     template = pop_of(proc, Str, "a format string").data
-    return template, scalars(items)
+    return template, scalars(items, vm.max_stack)
 
 
 def encoder(convert):
     """ENCODE1 (BASIC image), ENCODE2 (C format): a b1 … bn n → the string."""
     def handler(vm: VM, proc: Process) -> None:
-        text = convert(*_pop_data(proc))
+        text = convert(*_pop_data(vm, proc))
         vm.claim(len(text))
         proc.push(Str(text))
     return handler

@@ -69,6 +69,13 @@ def test_data_piled_up_by_a_loop_is_bounded_by_the_memory_limit(step: str) -> No
     assert error_of(program, budget=None, memory_limit=100_000).kind is K.MEMORY_EXHAUSTED
 
 
+@pytest.mark.parametrize("use", ["DESTA", '"#" EXCH 1 ENCODE1', '"%d" EXCH 1 ENCODE2'])
+def test_an_array_is_not_expanded_beyond_the_data_stack(use: str) -> None:
+    """Its elements are counted first: 16 MiB of I1 would otherwise be 16 M numbers (1 GB)."""
+    program = f"1000 #Ar(0, I1) #x ALLOC DROP x {use}"
+    assert error_of(program, max_stack=500).kind is K.STACK_OVERFLOW
+
+
 def test_recursion_with_a_branch() -> None:
     factorial = ("#f Fn{ DUP 1 GT >rec BRT RET rec: DUP DEC f MUL END } STORE I4:10 f")
     assert stack_of(factorial) == ["3628800"]
