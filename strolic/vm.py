@@ -20,6 +20,8 @@ from .variables import Scope, find
 SLICE = 200              # instructions a process runs before the scheduler looks again
 INTERRUPT_PRIORITY = float("-inf")   # interrupt processes go before every process
 DEFAULT_EPS = 1e-6
+MAX_BODY = 1 << 19       # bytes of a function body compiled: at most 256 Ki codes (about 40 MB)
+INSTRUCTION_BYTES = 160  # memory one compiled code takes, counted against memory_limit
 
 
 class VM:
@@ -36,6 +38,7 @@ class VM:
         self.memory_limit = memory_limit   # bytes of data held at once (stacks, heap, output)
         self.made = 0                      # bytes of data made since memory was last measured
         self._compiled: dict[bytes, list] = {}
+        self._compiled_bytes = 0           # bytes of the bodies in _compiled
         self.generation = 0                # bumped whenever waiting processes may proceed
         self.executed = 0                  # instructions of the current run (budget)
         self.budget: int | None = None
@@ -100,13 +103,25 @@ class VM:
         held = {id(item): item for p in self.processes.values() for item in p.stack
                 if isinstance(item, DATA_TYPES)}
         return (sum(len(data_of(item)) for item in held.values()) + self.heap_in_use()
-                + self.host.memory_in_use())
+                + self.host.memory_in_use() + self.code_in_use())
+
+    def code_in_use(self) -> int:
+        """Bytes of the compiled bodies cached or executing (a frame or a return destination)."""
+        frames = [p.frame for p in self.processes.values()] + [
+            frame for p in self.processes.values() for kind, frame in p.returns if kind == "call"]
+        held = {id(codes): codes for codes in self._compiled.values()}
+        held.update((id(frame.codes), frame.codes) for frame in frames)
+        return sum(map(len, held.values())) * INSTRUCTION_BYTES
 
     def claim(self, size: int) -> None:
         """A function makes a datum of ``size`` bytes: refused when the data held would pass
-        ``memory_limit`` (a loop piling up copies of a large string). What is held is measured
-        only when the bytes made since the last measurement could pass the limit."""
+        ``memory_limit`` (a loop piling up copies of a large string)."""
         check_datum_size(size)
+        self.account(size)
+
+    def account(self, size: int) -> None:
+        """``size`` bytes more are held; what is held is measured only when the bytes made since
+        the last measurement could pass ``memory_limit``."""
         self.made += size
         if self.made > self.memory_limit:
             self.made = self.memory_in_use() + size
@@ -139,9 +154,26 @@ class VM:
         """A frame for a function body; bodies are compiled once (offsets relative to the body)."""
         codes = self._compiled.get(function.body)
         if codes is None:
-            codes = self._compiled[function.body] = self.compile(decode_function(function),
-                                                                 function.origin or 0)
+            codes = self._compile_body(function)
         return Frame(codes, function.origin or 0, function, name)
+
+    def _compile_body(self, function: Function) -> list:
+        """A body made at run time (EMBB into an Fn area) may be megabytes, and a code takes
+        about INSTRUCTION_BYTES compiled: too long a body is refused before it is decoded, the
+        compiled code counts against memory_limit, and the cache is emptied once it holds more
+        than MAX_BODY bytes of bodies (a loop calling ever new bodies)."""
+        body = function.body
+        if len(body) > MAX_BODY:
+            raise fail(K.MEMORY_EXHAUSTED, f"function data of {len(body)} bytes cannot be "
+                                           f"executed (at most {MAX_BODY})")
+        self.account(len(body) // 2 * INSTRUCTION_BYTES)
+        if self._compiled_bytes + len(body) > MAX_BODY:
+            self._compiled.clear()
+            self._compiled_bytes = 0
+        codes = self._compiled[body] = self.compile(decode_function(function),
+                                                    function.origin or 0)
+        self._compiled_bytes += len(body)
+        return codes
 
     # ---- running --------------------------------------------------------------------------------
     def run(self, program: bytes | list, budget: int | None = None) -> Process:

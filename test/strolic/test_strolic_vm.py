@@ -10,6 +10,7 @@ from strolic.codec import encode
 from strolic.codes import Num, I2
 from strolic.errors import ExceptionKind as K, StrolicError
 from strolic.text import assemble
+from strolic import vm as vm_module
 from strolic.vm import VM
 from test_strolic_codec import program_codes
 
@@ -74,6 +75,16 @@ def test_an_array_is_not_expanded_beyond_the_data_stack(use: str) -> None:
     """Its elements are counted first: 16 MiB of I1 would otherwise be 16 M numbers (1 GB)."""
     program = f"1000 #Ar(0, I1) #x ALLOC DROP x {use}"
     assert error_of(program, max_stack=500).kind is K.STACK_OVERFLOW
+
+
+def test_function_data_made_at_run_time_is_compiled_within_the_limits(monkeypatch) -> None:
+    """8 MiB of codes EMBB'd into an Fn area took 1.1 GB to compile."""
+    drops = " ".join(["DROP"] * 100)
+    assert error_of(f"#f Fn{{ {drops} END }} STORE f",
+                    memory_limit=10_000).kind is K.MEMORY_EXHAUSTED
+    monkeypatch.setattr(vm_module, "MAX_BODY", 100)
+    assert error_of(f"#f Fn{{ {drops} END }} STORE f").kind is K.MEMORY_EXHAUSTED
+    assert stack_of("1 #f Fn{ DROP 2 END } STORE f") == ["2"]
 
 
 def test_recursion_with_a_branch() -> None:
