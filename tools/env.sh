@@ -7,4 +7,6 @@ export FASTDDS_BUILTIN_TRANSPORTS="${FASTDDS_BUILTIN_TRANSPORTS:-UDPv4}"
 if [ -f "$_acti_root/install/setup.sh" ]; then
   COLCON_CURRENT_PREFIX="$_acti_root/install" source "$_acti_root/install/setup.sh"
 fi
+# no ROS 2 install sourced: the few `ros2` commands of the README (tools/ros2_lite.py)
+command -v ros2 >/dev/null 2>&1 || export PATH="$_acti_root/tools/bin:$PATH"
 unset _acti_root
