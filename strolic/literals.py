@@ -12,6 +12,8 @@ from .codes import (ARRAY, LENGTH_TAGS, R4, R8, TAG_NAMES, Array, Function, Func
 from .values import array_elements
 
 PRINTABLE = set(range(0x20, 0x7F)) - {ord('"'), ord("\\")}
+ESCAPES = {b: f"\\x{b:02x}" for b in range(256) if b not in PRINTABLE}   # str.translate table
+ELEMENTS_AT_ONCE = 4096      # array elements formatted together (a huge array is no huge list)
 
 
 def format_real32(value: float) -> str:
@@ -32,7 +34,9 @@ def format_number(num: Num, typed: bool = True) -> str:
 
 
 def format_string(data: bytes) -> str:
-    return '"' + "".join(chr(b) if b in PRINTABLE else f"\\x{b:02x}" for b in data) + '"'
+    """Escaped through a translate table: a string of megabytes costs its text, not a string
+    object per byte."""
+    return '"' + data.decode("latin-1").translate(ESCAPES) + '"'
 
 
 def format_head(head: TagHead) -> str:
@@ -58,6 +62,14 @@ def format_element(value) -> str:
     return format_value(value)
 
 
+def format_elements(array: Array) -> str:
+    """The elements of an array, ELEMENTS_AT_ONCE at a time: 16 MiB of I1 would otherwise be
+    16 M numbers and their texts at once (gigabytes)."""
+    step = array.element.element_size() * ELEMENTS_AT_ONCE or 1
+    return " ".join(" ".join(map(format_element, array_elements(Array(array.element, part))))
+                    for part in (array.data[i:i + step] for i in range(0, len(array.data), step)))
+
+
 def format_value(value) -> str:
     """Any stack item in the text form."""
     if isinstance(value, Num):
@@ -75,7 +87,7 @@ def format_value(value) -> str:
     if isinstance(value, Pose):
         return "Pm(" + " ".join(format_number(e) for e in value.elements) + ")"
     if isinstance(value, Array):
-        elements = " ".join(format_element(e) for e in array_elements(value))
+        elements = format_elements(value)
         return f"Ar[{format_head(value.element)}{' ' if elements else ''}{elements}]"
     if isinstance(value, UserCode):
         return "#" + format_user_code(value.code)

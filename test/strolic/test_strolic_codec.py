@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import struct
+import tracemalloc
 
 import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
@@ -279,3 +280,13 @@ def test_deep_nesting_is_an_invalid_code_not_a_crash() -> None:
         assemble("Fn{ " * 2000)
     with pytest.raises(StrolicError):
         assemble("#" + "Ar(0, " * 2000)
+
+
+@pytest.mark.parametrize("value", [Str(bytes(1 << 18)), Array(TagHead(I1), bytes(1 << 18))])
+def test_a_long_datum_is_formatted_without_an_object_per_byte(value) -> None:
+    """TRACE, OUTPUT and --stack of 16 MiB took gigabytes (a string object per byte)."""
+    tracemalloc.start()
+    text = format_value(value)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert len(text) > 1 << 19 and peak < 12 * len(text)
