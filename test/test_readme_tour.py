@@ -1,5 +1,6 @@
-"""The README's quick tour, pasted in order into bash against the main job, works: every service
-call is answered with success, every wait ends completed, the jog and the echo run.
+"""The README's quick tour, then its examples of the arm's actions and of a robot program, pasted
+in order into bash against the main job, work: every service call is answered with success,
+every goal and program ends well, the jog and the echo run.
 
 The `ros2` of `tools/bin` (tools/ros2_lite.py: the real CLI is not on PyPI) runs the lines; the two
 commands that run until Ctrl-C get a bound (`topic pub -t 10`, `topic echo --once`)."""
@@ -14,12 +15,15 @@ robot = node_fixture("acti_bringup")
 TOUR_TIMEOUT_S = 240      # below the suite's 300 s per test: a hang shows its output
 
 
+PASTED = ("## Quick tour", "### acti_middle_node actions and topics", "## Robot programs")
+
+
 def quick_tour() -> str:
-    """The first bash block under '## Quick tour', the endless commands bounded."""
+    """The first bash block under each heading of PASTED, the endless commands bounded."""
     with open(os.path.join(ROOT, "README.md"), encoding="utf-8") as f:
         readme = f.read()
-    section = readme.split("## Quick tour", 1)[1]
-    block = section.split("```bash\n", 1)[1].split("```", 1)[0]
+    block = "".join(readme.split(f"\n{heading}\n", 1)[1].split("```bash\n", 1)[1].split("```", 1)[0]
+                    for heading in PASTED)
     block = re.sub(r"^ros2 topic pub ", "ros2 topic pub -t 10 ", block, flags=re.M)
     return re.sub(r"^ros2 topic echo ", "ros2 topic echo --once ", block, flags=re.M)
 

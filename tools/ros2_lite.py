@@ -110,7 +110,7 @@ def request(cls: type, text: str | None) -> Any:
     return fill(cls(), values or {})
 
 
-# --- waiting ----------------------------------------------------------------------------------------
+# --- waiting --------------------------------------------------------------------------------------
 def spin_until(node: Node, done: Callable[[], bool], timeout: float | None, what: str) -> None:
     deadline = None if timeout is None else time.monotonic() + timeout
     while not done():
@@ -130,7 +130,7 @@ def topic_type(node: Node, topic: str) -> str:
     raise Usage(f"the topic {topic} does not appear (give its type)")
 
 
-# --- commands ---------------------------------------------------------------------------------------
+# --- commands -------------------------------------------------------------------------------------
 def service_call(node: Node, a: argparse.Namespace) -> None:
     cls = interface(a.type)
     req = request(cls.Request, a.values)
@@ -238,7 +238,8 @@ def param(node: Node, a: argparse.Namespace) -> None:
         if not values or values[0].type == 0:
             print("Parameter not set.")
             return
-        print(f"Parameter value is: {Parameter.from_parameter_msg(_named(a.name, values[0])).value}")
+        value = Parameter.from_parameter_msg(_named(a.name, values[0])).value
+        print(f"Parameter value is: {value}")
     elif a.verb == "describe":
         for d in _answer(node, client.describe_parameters([a.name]), a.node).descriptors:
             print(f"Parameter name: {d.name}\n  Type: {Parameter.Type(d.type).name.lower()}\n"
