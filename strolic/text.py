@@ -55,6 +55,7 @@ class Assembler:
         self.pos = 0
         self.names: dict[str, int] = {}
         self.depth = 0
+        self.array_depth = 0
 
     # ---- token access --------------------------------------------------------------------
     def peek(self) -> tuple[str, str, int] | None:
@@ -259,7 +260,12 @@ class Assembler:
         return self.number(word)
 
     def array(self) -> Array:
+        """``Ar[head elements…]``; array literals in array literals are counted, as heads are,
+        so that a deep nest is an error and not a Python recursion error."""
         self.expect("[")
+        self.array_depth += 1
+        if self.array_depth > MAX_NESTING:
+            raise self.error(f"arrays nested deeper than {MAX_NESTING}")
         element = self.head(self.next()[1])
         if element.tag in (SUPPRESS, INDIRECT):
             raise self.error("array elements must be data")
@@ -274,6 +280,7 @@ class Assembler:
                 raise self.error(f"element {word!r} is not of the element type")
             data.append(data_of(value))
         self.expect("]")
+        self.array_depth -= 1
         return Array(element, b"".join(data))
 
 

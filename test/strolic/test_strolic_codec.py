@@ -280,6 +280,8 @@ def test_deep_nesting_is_an_invalid_code_not_a_crash() -> None:
         assemble("Fn{ " * 2000)
     with pytest.raises(StrolicError):
         assemble("#" + "Ar(0, " * 2000)
+    with pytest.raises(StrolicError):                 # array literals in array literals
+        assemble("Ar[Ar(4, I2) " * 3000)
 
 
 @pytest.mark.parametrize("value", [Str(bytes(1 << 18)), Array(TagHead(I1), bytes(1 << 18))])
