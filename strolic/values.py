@@ -8,6 +8,8 @@ from __future__ import annotations
 import math
 import struct
 
+import numpy as np
+
 from .codes import (ARRAY, FIXED_SIZE, FUNCTION, I1, INDIRECT, INT_FORMAT, INTEGER_TAGS,
                     LENGTH_TAGS, NUMERIC_TAGS, POSE, R4, R8, REAL_FORMAT, RECORD, STRING,
                     SUPPRESS, TAG_NAMES, TRANSFORM, VECTOR, Array, Function, FunctionCode, Num,
@@ -217,8 +219,7 @@ def value_from_data(head: TagHead, data: bytes, offset: int = 0) -> object:
         if (size == 0 and data) or (size and len(data) % size):
             raise invalid(f"array length {len(data)} is not a multiple of element size {size}",
                           offset)
-        for start in range(0, len(data), size or 1):   # every element must be valid data
-            value_from_data(head.element, data[start:start + size], offset + start)
+        _check_elements(head.element, data, size, offset)
         return Array(head.element, bytes(data))
     if tag == POSE:
         reader = Reader(bytes(data), offset)
@@ -227,6 +228,27 @@ def value_from_data(head: TagHead, data: bytes, offset: int = 0) -> object:
             elements.append(reader.number())
         return Pose(tuple(elements))
     raise invalid(f"{TAG_NAMES.get(tag, hex(tag))} has no data", offset)
+
+
+# elements checked at once: every bit pattern is valid data, or a real's must be finite
+_ANY_BITS = (*INTEGER_TAGS, STRING, RECORD, FUNCTION)
+_REAL_DTYPES = {R4: ">f4", R8: ">f8", VECTOR: ">f4", TRANSFORM: ">f4"}
+
+
+def _check_elements(element: TagHead, data: bytes, size: int, offset: int) -> None:
+    """Every element of an array's data part must be valid data. Flat elements are checked at
+    once (element by element, a 16 MiB area took 4.5 s to read back); nested ones one by one."""
+    if element.tag in _ANY_BITS:
+        return
+    if element.tag in _REAL_DTYPES:
+        reals = np.frombuffer(data, dtype=_REAL_DTYPES[element.tag])
+        bad = np.flatnonzero(~np.isfinite(reals))
+        if len(bad):
+            at = int(bad[0]) * reals.itemsize // size * size
+            value_from_data(element, data[at:at + size], offset + at)    # says what is wrong
+        return
+    for start in range(0, len(data), size or 1):
+        value_from_data(element, data[start:start + size], offset + start)
 
 
 def array_elements(array: Array) -> list:

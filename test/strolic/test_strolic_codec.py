@@ -81,6 +81,23 @@ def test_invalid_codes_are_reported(text: str, reason: str) -> None:
     assert caught.value.offset is not None
 
 
+@pytest.mark.parametrize("element, bad, at", [
+    ("F6", "7FF0000000000000", 9 * 8),             # R8 elements, the tenth +inf
+    ("F5", "7FC00000", 9 * 4),                     # R4, NaN
+    ("FF01", "3F800000 7FC00000 3F800000", 9 * 12),  # vectors, the tenth's y NaN
+])
+def test_a_bad_element_deep_in_an_array_is_reported_at_its_offset(element: str, bad: str,
+                                                                   at: int) -> None:
+    """Flat arrays are checked at once (numpy), nested ones element by element: the same report."""
+    good = {"F6": "3FF0000000000000", "F5": "3F800000", "FF01": "3F800000" * 3}[element]
+    data = hexed(good * 9 + bad + good * 40)       # over 127 bytes: an I2 length
+    head = f"F9 F2 {len(data):04X} {element}"
+    with pytest.raises(StrolicError) as caught:
+        decode(hexed(head) + data)
+    assert caught.value.kind is K.INVALID_CODE
+    assert caught.value.offset == len(hexed(head)) + at
+
+
 def hexed(text: str) -> bytes:
     return bytes.fromhex(text.replace(" ", ""))
 
