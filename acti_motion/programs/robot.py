@@ -276,7 +276,7 @@ class RobotHost(Host):
             self.abnormal = STATUS_ALARM
             kind = K.OUT_OF_OPERATING_REGION if new[0].code in (4, 5) else K.ROBOT_ERROR
             return kind, f"alarm 0x{new[0].code:X}: {new[0].description}"
-        over = {i for i in self.pending if i <= device.retired_id}
+        over = {i for i in self.pending if device.is_over(i)}   # not while a stop decelerates it
         self.pending -= over
         lost = sorted(i for i in over if device.was_discarded(i))
         if not lost:
@@ -585,7 +585,7 @@ class RobotHost(Host):
             except Flag as flag:
                 raise fail(K.ROBOT_ERROR, f"calibration move refused: {flag.reason}") from None
             motion_id = self._waits[key] = self.last_motion
-        if self.arm.device.retired_id < motion_id:
+        if not self.arm.device.is_over(motion_id):
             proc.wake_at = self.now() + POLL
             return WAIT
         del self._waits[key]

@@ -188,6 +188,29 @@ def test_a_motion_error_or_cancel_stops_the_program_and_the_arm(arm, executor, e
     assert arm_rest_after(executor, arm, when["at"]) < arm.accel_time_joint + 0.25
 
 
+@pytest.mark.parametrize("event, kind", [("stop", K.ROBOT_ERROR), ("servo off", K.SERVO_ERROR)])
+def test_a_stop_is_seen_by_a_program_with_another_clients_motion_queued_behind_it(
+        arm, executor, event, kind):  # noqa: F811
+    """A stop retires the motions queued behind the current one at once, while the current one
+    (the program's) still decelerates: its $WAIT must not take it for completed and go on."""
+    t0, done = executor.world.time, {}
+    assert arm.set_speed_joint(50).ok
+
+    def hook():
+        if "queued" not in done and arm.device.moving:
+            done["queued"] = arm.move_ptp_joint_rel([0.0] * 6 + [5.0])
+        elif "stopped" not in done and executor.world.time - t0 > 0.5:
+            done["stopped"] = arm.stop() if event == "stop" else arm.servo_off()
+    result = run(arm, executor, "80 JSPEED DROP Ar[R8 40 0 0 0 0 0 0] IDRIVE DROP -1 $WAIT DROP "
+                                "0.2 DELAY DROP Ar[R8 -80 0 0 0 0 0 0] IDRIVE DROP -1 $WAIT",
+                 hook=hook)
+    assert done["queued"].ok and done["stopped"].ok
+    assert result.status is Status.EXCEPTION and result.error.kind is kind, result.report
+    assert "motion 1 of the program" in result.report       # stopped in the first $WAIT
+    arm_rest_after(executor, arm, executor.world.time)
+    assert np.degrees(arm.feedback_joints[0]) > WORK[0] + 1.0   # the second move never ran
+
+
 def test_a_program_exception_stops_the_arm(arm, executor):  # noqa: F811
     result = run(arm, executor, "Ar[R8 60 0 0 0 0 0 0] IDRIVE DROP 0.5 DELAY DROP 1 0 DIV")
     assert result.status is Status.EXCEPTION and result.error.kind is K.DIVISION_BY_ZERO
