@@ -230,6 +230,20 @@ class Device:
             self.hold = self.queued_end = rest
             self.changed.notify_all()
 
+    def renumber(self, entry: QueuedMotion) -> int:
+        """(lock held) The running motion `entry`, taken over by a command with another goal,
+        goes on as that command's motion: its old id retires as discarded (it never reached its
+        end, so a wait on it says not completed) and it runs on under a new id, returned."""
+        self.discarded += 1
+        self._discarded_ids.append((entry.id, entry.id))
+        self.retired_id = max(self.retired_id, entry.id)
+        self.last_id += 1
+        entry.id = self.last_id
+        self.revision += 1
+        self.changed.notify_all()
+        self._announce_retired()
+        return entry.id
+
     def is_over(self, motion_id: int) -> bool:
         """Motion `motion_id` finished or was discarded. `retired_id` alone is not enough: a stop
         retires the queue behind the current motion at once while the current one still

@@ -135,7 +135,10 @@ def test_continuous_rel_new_target_replaces_the_old_with_continuous_velocity(
     first = base.move_continuous_rel((2000.0, 0.0, 0.0)).values["motion_id"]
     trace.step(1.5)
     here = reference_now(base)
-    assert base.move_continuous_rel(rel).values["motion_id"] == first
+    # the old target is erased (連続実行…最後に設定された目標点以外は消去): its id is over, not
+    # completed, and the motion runs on as the new command's
+    assert base.move_continuous_rel(rel).values["motion_id"] == first + 1
+    assert base.device.is_over(first) and base.device.was_discarded(first)
     trace.until_idle()
     assert_at(base, *expected_mm(here, rel))
     trace.check(accel=setting(base))                              # no jump in speed
@@ -183,7 +186,8 @@ def test_continuous_rel_takes_over_another_kind_of_move_smoothly(base, executor,
     assert_at(base, *expected_mm(here, (800.0, 300.0, 0.0)))
     trace.check(accel=setting(base))
     assert min(p.v for p in trace.points[int(2.0 / executor.dt):int(2.5 / executor.dt)]) > 0.2
-    assert (base.device.completed, base.device.discarded) == (1, 1)
+    # the queued move and the one taken over (it never reached its goal) are discarded
+    assert (base.device.completed, base.device.discarded) == (1, 2)
 
 
 def test_set_velocity_while_cruising(base, executor):  # noqa: F811

@@ -74,10 +74,15 @@ def test_jog_needs_only_the_servo_and_takes_over_a_move(base, executor):  # noqa
 def test_jog_takes_over_a_running_move_with_continuous_speed(base, executor):  # noqa: F811
     ready(base)
     base.set_jog_timeout(3000)
-    base.move_forward(2000.0)
+    forward = base.move_forward(2000.0).values["motion_id"]
     speeds = []
     run_until(executor, lambda: speeds.append(base.odometry.v) or base.odometry.v > 0.25, 5.0)
-    assert base.move_jog(-100.0, 0.0, 0.0).ok and base.device.current.label == "move_jog"
+    r = base.move_jog(-100.0, 0.0, 0.0)
+    assert r.ok and base.device.current.label == "move_jog"
+    # the move never reaches its goal: over, not completed; the jog is a motion of its own …
+    assert base.device.is_over(forward) and base.device.was_discarded(forward)
+    assert r.values["motion_id"] == forward + 1
+    assert base.move_jog(-100.0, 0.0, 0.0).values["motion_id"] == forward + 1   # … kept by jogs
     run_until(executor, lambda: speeds.append(base.odometry.v) or base.odometry.v < -0.09, 5.0)
     assert max(abs(b - a) for a, b in zip(speeds, speeds[1:])) / executor.dt < 0.5 * 1.3
 

@@ -606,12 +606,16 @@ class VehicleCore(Sensing):
 
     def _take_over(self, device: Device, cur: Any, t: float, path: Path, label: str) -> Any:
         """Commit: the running motion follows `path` from motion time t as a `label` motion;
-        what was queued behind it was planned from its old end and is discarded."""
+        what was queued behind it was planned from its old end and is discarded. A move taken
+        over never reaches its goal: it retires as discarded and the motion runs on under a
+        new id; a jog (or the joystick) updating itself keeps its id."""
         if device.t > t:
             return STALE
         self._admit(SERVO_ON, label, device)
         device.discard_queue()
         self._op_generation = device.generation         # this operation's own discard
+        if not (label == cur.label and label in VELOCITY_DRIVEN):
+            device.renumber(cur)
         cur.motion = cur.motion.handover(t, path, label)
         cur.label = label
         return cur.id
