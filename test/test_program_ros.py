@@ -95,6 +95,8 @@ def test_cancel_mid_motion_stops_the_arm_within_its_deceleration_time(ros, progr
     status, result = programs.result(handle)
     assert status == GoalStatus.STATUS_CANCELED and result.status == R.CANCELED
     assert result.exception_kind == "stopped by the operator" and result.stack == ["-1"]
+    # answered once the arm is at rest: a program sent now is not discarded by that stop
+    assert not call(ros, "get_state", srv.GetState).state & 0x02
     assert ros.spin_until(lambda: any(t > sent_at and not word & 0x02 for t, word in states),
                       10.0)
     rest_at = next(t for t, word in states if t > sent_at and not word & 0x02)

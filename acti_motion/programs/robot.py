@@ -19,6 +19,7 @@ import math
 import struct
 import sys
 import threading
+import time
 from dataclasses import dataclass
 from typing import Callable
 
@@ -51,6 +52,8 @@ STATUS_DISCARDED = -1
 STATUS_ALARM = -2
 
 POLL = 1.0 / 120.0             # s (simulated) between two looks of a waiting function
+REST_POLL_S = 0.002            # s (wall) between two looks at a stopping arm
+REST_TIMEOUT_S = 60.0          # s (wall): the longest stop (10 s accel time) at real-time factor ⅙
 MAX_DELAY = 86400.0            # s
 MAX_ACCURACY = 100.0           # mm: SACC radius
 MAX_RAMP = 10.0                # s: ACCEL2 / DECEL2
@@ -232,6 +235,20 @@ class RobotHost(Host):
         """The program stopped on an exception: the arm decelerates and its queue is discarded."""
         self.state = "stopping"
         self.arm.stop_motion()
+
+    def wait_at_rest(self) -> None:
+        """After a stop: until the arm is at rest, so that a run ends with the robot stopped
+        (§4.5) and its client can start again at once (a canceled run answered while the arm
+        still decelerated, and the next program's first move was discarded by that stop)."""
+        device, executor = self.arm.device, self.arm.executor
+        deadline = time.monotonic() + REST_TIMEOUT_S
+        while device.stopping and time.monotonic() < deadline:
+            if self.step is not None:
+                self.step()
+            elif executor.running:
+                time.sleep(REST_POLL_S)
+            else:               # the simulation ended (shutdown): nothing will come to rest
+                return
 
     # digital I/O: RobotIO, and the status port
     def io_port_bits(self, port: int, output: bool) -> int | None:

@@ -88,6 +88,7 @@ class ProgramRun:
         except StrolicError as e:
             if host.state != "stopping":
                 host.stop(e)
+            host.wait_at_rest()
             status = Status.CANCELED if e.kind is K.STOPPED else Status.EXCEPTION
             error = e
         host.state = status.name.lower()
