@@ -156,3 +156,29 @@ def test_a_change_through_a_service_shows_in_the_parameter(ros, arm_node):
     assert r.return_id.id == 0
     assert wait_until(lambda: list(get_param(ros, "soft_limit_cartesian").double_array_value)
                       == [-1000.0, 1200.0, -1000.0, 1000.0, -100.0, 1600.0], 10.0)
+
+
+# a node without /clock: its own cadence must not hang on use_sim_time
+quiet_clock_node = node_fixture("acti_middle_node", "clock_rate_hz:=0.0", namespace="/quiet")
+
+
+def test_use_sim_time_set_at_run_time_without_a_clock_stops_nothing(ros, quiet_clock_node):
+    """The state topic, the settings mirrored into parameters and the action feedback run on
+    the steady clock: use_sim_time (rclpy's own, settable) with no /clock stopped all three."""
+    from acti_msgs.msg import ArmState
+    node = "/quiet" + ARM
+    r = ros.call(SetParameters, node + "set_parameters", parameters=[Parameter(
+        name="use_sim_time", value=ParameterValue(type=ParameterType.PARAMETER_BOOL,
+                                                  bool_value=True))]).results[0]
+    assert r.successful
+    states = []
+    sub = ros.node.create_subscription(ArmState, node + "state", states.append, 10)
+    try:
+        assert ros.spin_until(lambda: len(states) >= 10, 10.0), f"{len(states)} states"
+    finally:
+        ros.node.destroy_subscription(sub)
+    assert ros.call(srv.SetAccelTimeJoint, node + "set_accel_time_joint",
+                    acl_time=0.7).return_id.id == 0
+    assert wait_until(lambda: ros.call(GetParameters, node + "get_parameters",
+                                       names=["accel_time_joint"]).values[0].double_value
+                      == 0.7, 10.0)

@@ -27,7 +27,9 @@ from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.signals import SignalHandlerOptions
 from rclpy.experimental import EventsExecutor
 from rclpy.logging import get_logger
+from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
+from rclpy.timer import Timer
 
 from acti_bringup.serving.responses import LateResponses
 
@@ -84,6 +86,17 @@ def build_or_exit(build: Callable[[], T], name: str) -> T:
         return build()
     except (ValueError, InvalidParameterTypeException, InvalidParameterValueException) as e:
         _cannot_start(name, e)
+
+
+_STEADY = Clock(clock_type=ClockType.STEADY_TIME)
+
+
+def steady_timer(node: Node, period: float, callback: Callable[[], None]) -> Timer:
+    """A timer of the node's own cadence (state topics, action feedback) on the steady clock:
+    on the node's clock it would stop whenever `use_sim_time` is set and no /clock comes
+    (a node's `use_sim_time` can be set at run time), and with it the state topic, the
+    settings mirrored into parameters and every waiting action goal."""
+    return node.create_timer(period, callback, clock=_STEADY)
 
 
 class SpinLoop:

@@ -19,6 +19,7 @@ from rclpy.action import CancelResponse, GoalResponse
 from rclpy.node import Node
 from rclpy.task import Future
 
+from acti_bringup.serving.spinning import steady_timer
 from acti_motion.executor import Device
 
 T = TypeVar("T")
@@ -62,7 +63,7 @@ class Watch:
     def __init__(self, node: Node, period: float) -> None:
         self._waits: list[_Wait] = []
         self._guard = node.create_guard_condition(self._settle)
-        self._timer = node.create_timer(period, self._tick)
+        self._timer = steady_timer(node, period, self._tick)
         self._timer.cancel()                     # ticks only while something waits
         self._closing = node.context.ok
 
