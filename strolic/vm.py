@@ -287,6 +287,8 @@ class VM:
                     self.fall_off(proc)
                 else:
                     instruction = codes[pc]
+                    if budget is not None and self.executed + count >= budget:
+                        raise fail(K.INSTRUCTION_BUDGET, f"{budget} instructions executed")
                     frame.pc = pc + 1
                     op = instruction[0]
                     if op == PUSH:
@@ -307,8 +309,6 @@ class VM:
                     if len(stack) > self.max_stack:
                         raise fail(K.STACK_OVERFLOW, f"more than {self.max_stack} items")
                     count += 1
-                    if budget is not None and self.executed + count > budget:
-                        raise fail(K.INSTRUCTION_BUDGET, f"{budget} instructions executed")
                 if proc.frame is not frame:
                     frame = proc.frame
                     codes = frame.codes

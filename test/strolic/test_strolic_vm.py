@@ -44,6 +44,16 @@ def test_instruction_budget_bounds_a_runaway_loop() -> None:
     assert error.kind is K.INSTRUCTION_BUDGET
 
 
+@pytest.mark.parametrize("budget", [1, 2, 3])
+def test_a_budget_of_n_runs_exactly_n_instructions(budget: int) -> None:
+    """The instruction past the budget is not run (it was, and counted: n + 1)."""
+    vm = VM()
+    with pytest.raises(StrolicError) as caught:
+        vm.run(assemble("1 RESULT 2 RESULT 3 RESULT"), budget=budget)
+    assert caught.value.kind is K.INSTRUCTION_BUDGET and vm.executed == budget
+    assert len(vm.host.output) == budget // 2          # each RESULT is the 2nd of a pair
+
+
 def test_data_stack_and_return_stack_overflow() -> None:
     assert error_of("1 2 3 4 5 6", max_stack=5).kind is K.STACK_OVERFLOW
     assert error_of("#f Fn{ f END } STORE f", max_return_depth=50).kind is K.STACK_OVERFLOW
