@@ -18,6 +18,7 @@ from acti_bringup.serving.conversions import fill, to_core
 from acti_bringup.serving.waiting import GoalSlots, accept_cancel, device_watch, wait_for_motion
 from acti_motion.arm.core import ArmCore
 from acti_motion.replies import Reply, ReturnCode
+from acti_motion.config_fields import GOALS_RANGE, RATE_RANGE_HZ, ranged
 
 # Move.Goal.kind → the core operation and the goal fields it takes (core name ← goal field).
 MOVE_KINDS: dict[str, tuple[tuple[str, str], ...]] = {
@@ -38,8 +39,10 @@ MOVE_KINDS: dict[str, tuple[tuple[str, str], ...]] = {
 
 @dataclass
 class ActionConfig:
-    feedback_rate_hz: float = 10.0   # feedback of ~/wait_motion and ~/move [Hz]
-    max_action_goals: int = 16       # goals of both actions running at once; more are rejected
+    # feedback of ~/wait_motion and ~/move [Hz]
+    feedback_rate_hz: float = ranged(10.0, *RATE_RANGE_HZ)
+    # goals of both actions running at once; more are rejected
+    max_action_goals: int = ranged(16, *GOALS_RANGE)
 
 
 def return_id(reply: Reply) -> ReturnId:

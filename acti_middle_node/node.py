@@ -19,11 +19,12 @@ from acti_middle_node.program_action import ProgramAction
 from acti_motion.arm.core import ArmConfig, ArmCore
 from acti_motion.replies import Reply
 from acti_motion.programs.robot import ProgramDefaults
+from acti_motion.config_fields import RATE_RANGE_HZ, ranged
 
 
 @dataclass
 class TopicConfig:
-    state_rate_hz: float = 20.0      # ~/state publication rate [Hz]
+    state_rate_hz: float = ranged(20.0, *RATE_RANGE_HZ)  # ~/state publication rate [Hz]
 
 
 # The parameters that take effect at run time: how each is set (through the service that sets
@@ -61,8 +62,6 @@ class ArmNode(Node):
         serve_operations(self, self.motion, self.core, OPERATIONS, write_return_id)
         actions = declare_config(self, ActionConfig)
         topics = declare_config(self, TopicConfig)
-        if actions.feedback_rate_hz <= 0 or topics.state_rate_hz <= 0:
-            raise ValueError("feedback_rate_hz and state_rate_hz must be > 0")
         self.actions = MotionActions(self.goals, self.core, actions)
         self.programs = ProgramAction(self.goals, self.core, actions.feedback_rate_hz,
                                       declare_config(self, ProgramDefaults))

@@ -7,6 +7,11 @@ import dataclasses
 from typing import Any
 
 
+QUEUE_SIZE_RANGE = (1, 100000)           # motions a device's queue holds
+RATE_RANGE_HZ = (0.1, 1000.0)            # a node's own topics and action feedback
+GOALS_RANGE = (1, 1000)                  # action goals held at once (each waits without a thread)
+
+
 def ranged(default: Any, lo: float, hi: float) -> Any:
     """A config field whose value must lie within [lo, hi]."""
     return dataclasses.field(default=default, metadata={"range": (lo, hi)})

@@ -13,18 +13,17 @@ from acti_bringup.serving.adapter import Plane
 from acti_bringup.serving.conversions import fill
 from acti_bringup.serving.waiting import GoalSlots, accept_cancel, device_watch, wait_for_motion
 from acti_motion.vehicle.core import VehicleCore
+from acti_motion.config_fields import GOALS_RANGE, RATE_RANGE_HZ, ranged
 
 
 @dataclass
 class WaitConfig:
-    wait_feedback_rate_hz: float = 10.0   # ~/wait_motion feedback [Hz]
-    max_wait_goals: int = 16              # ~/wait_motion goals at once; more are rejected
+    wait_feedback_rate_hz: float = ranged(10.0, *RATE_RANGE_HZ)  # ~/wait_motion feedback [Hz]
+    max_wait_goals: int = ranged(16, *GOALS_RANGE)  # ~/wait_motion goals at once; more are rejected
 
 
 class WaitMotionServer:
     def __init__(self, plane: Plane, core: VehicleCore, config: WaitConfig) -> None:
-        if config.wait_feedback_rate_hz <= 0:
-            raise ValueError("wait_feedback_rate_hz must be > 0")
         self.core = core
         self.watch = device_watch(plane, core.device, 1.0 / config.wait_feedback_rate_hz)
         slots = GoalSlots(plane.owner, config.max_wait_goals, "max_wait_goals")

@@ -22,7 +22,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from acti_motion.config_fields import ranged
+from acti_motion.config_fields import QUEUE_SIZE_RANGE, ranged
 from acti_motion.executor import MotionExecutor
 from acti_motion.arm.kinematics import ArmKinematics, Unreachable, rotate_about
 from acti_motion.arm.poses import Frames, compose_relative, hg_to_pose, inverse, pose_to_hg
@@ -61,6 +61,9 @@ REST_DRIFT_RAD = 1e-9                     # sensed joints this close give the sa
 # A stop decelerates over the running move's accel time, so an accel time of minutes is a
 # misconfiguration, not a setting; speeds below the minimums would time a move over days.
 MAX_ACCEL_TIME_S = 10.0
+# the shortest accel time at the fastest control rate (2 kHz): two cycles; a node refuses less than
+# two of its own cycles
+MIN_ACCEL_TIME_S = 0.001
 MIN_SPEED_JOINT_DEG_S = 0.1
 SPEED_TRANSLATION_MM_S = (1.0, 10000.0)
 SPEED_ROTATION_DEG_S = (0.1, 3600.0)
@@ -94,17 +97,17 @@ class ArmConfig:
     """Start-up settings of the arm (the node's parameters); units as on the services. The
     comment of each field is its parameter's description."""
     # motion queue capacity (FULL_MOTION_QUEUE_ERR beyond)
-    queue_size: int = 32
+    queue_size: int = ranged(32, *QUEUE_SIZE_RANGE)
     # joint and Cartesian speed ratio at start-up [%] (the spec says 0)
     initial_speed_ratio: int = ranged(0, 0, 100)
     # PTP accel/decel time [s] (set_accel_time_joint)
-    accel_time_joint: float = ranged(0.3, 0.0, MAX_ACCEL_TIME_S)
+    accel_time_joint: float = ranged(0.3, MIN_ACCEL_TIME_S, MAX_ACCEL_TIME_S)
     # minimum joint accel time [s]: joint accel limit = max speed / it (set_min_accel_time_joint)
-    min_accel_time_joint: float = ranged(0.1, 0.0, MAX_ACCEL_TIME_S)
+    min_accel_time_joint: float = ranged(0.1, MIN_ACCEL_TIME_S, MAX_ACCEL_TIME_S)
     # CP accel/decel time [s] (set_accel_time_cartesian)
-    accel_time_cartesian: float = ranged(0.3, 0.0, MAX_ACCEL_TIME_S)
+    accel_time_cartesian: float = ranged(0.3, MIN_ACCEL_TIME_S, MAX_ACCEL_TIME_S)
     # minimum CP accel time [s] (set_min_accel_time_cartesian)
-    min_accel_time_cartesian: float = ranged(0.1, 0.0, MAX_ACCEL_TIME_S)
+    min_accel_time_cartesian: float = ranged(0.1, MIN_ACCEL_TIME_S, MAX_ACCEL_TIME_S)
     # maximum CP speed [mm/s] (set_max_speed_cartesian)
     max_speed_translation: float = ranged(500.0, *SPEED_TRANSLATION_MM_S)
     # maximum CP rotation and elbow speed [degree/s] (set_max_speed_cartesian)
@@ -166,8 +169,6 @@ def _check_config(c: ArmConfig) -> None:
     the others are applied through their setters (`ArmCore._apply_settings`)."""
     if not (math.isfinite(c.gripper_speed) and c.gripper_speed > 0):
         raise ValueError(f"gripper_speed must be finite and > 0, got {c.gripper_speed}")
-    if c.queue_size < 1 or not 0 <= c.initial_speed_ratio <= 100:
-        raise ValueError("queue_size must be >= 1 and initial_speed_ratio within 0 … 100 %")
 
 
 def _in_range(x: float, lo: float, hi: float, name: str, unit: str) -> float:

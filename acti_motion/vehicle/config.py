@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from acti_motion.config_fields import check_ranges, ranged
+from acti_motion.config_fields import QUEUE_SIZE_RANGE, check_ranges, ranged
 
 
 MAX_STOP_S = 10.0      # the longest stop from the velocity limit at the acceleration limit [s]
@@ -15,7 +15,7 @@ MAX_STOP_S = 10.0      # the longest stop from the velocity limit at the acceler
 @dataclass
 class VehicleConfig:
     """Start-up settings and limits of the base (spec units); the node's parameters."""
-    queue_size: int = ranged(32, 1, 100000)  # motion queue capacity
+    queue_size: int = ranged(32, *QUEUE_SIZE_RANGE)  # motion queue capacity
     # velocity limit, translation [mm/s]
     velocity_limit_translation: float = ranged(1000.0, 1.0, 10000.0)
     # velocity limit, rotation [degree/s]
