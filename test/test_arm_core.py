@@ -82,6 +82,9 @@ def test_full_queue_refuses_and_keeps_what_is_queued(arm):
     assert arm.state_word() & 0x08
     r = arm.move_ptp_joint_abs(TARGET)
     assert r.code == ReturnCode.FULL_MOTION_QUEUE_ERR and "full" in r.comment
+    # a value no start makes valid is VALUE_ERR, full queue or not
+    r = arm.move_ptp_joint_rel([1e308] * 7)
+    assert r.code == ReturnCode.VALUE_ERR and "J1 by 1e+308°" in r.comment, r.comment
     assert arm.device.queue_length == 3
 
 

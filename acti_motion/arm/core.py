@@ -549,7 +549,9 @@ class ArmCore:
     @returns(*MOVE)
     def move_ptp_joint_rel(self, joint_points: list[float]) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
-        delta = np.radians(finite_vector(joint_points, self.axis_count, "joint_points"))
+        step = finite_vector(joint_points, self.axis_count, "joint_points")
+        self._check_joint_step(step, "joint_points")
+        delta = np.radians(step)
         return self.queue_joint_move(lambda start: start.joints + delta, "move_ptp_joint_rel")
 
     @returns(*MOVE)
@@ -719,6 +721,15 @@ class ArmCore:
             if not a - 1e-9 <= q <= b + 1e-9:
                 raise value_error(f"{name}: J{i + 1} = {q:g}° is outside the soft limit "
                                   f"[{a:g}, {b:g}]°")
+
+    def _check_joint_step(self, step_deg: np.ndarray, name: str) -> None:
+        """A relative move wider than a joint's soft-limit range leaves it from any start:
+        VALUE_ERR before the queue is looked at (a full queue would have hidden it)."""
+        span = (self.soft_limit_joint[:, 1] - self.soft_limit_joint[:, 0]).tolist()
+        for i, (d, w) in enumerate(zip(np.asarray(step_deg, float).tolist(), span)):
+            if abs(d) > w + 1e-9:
+                raise value_error(f"{name}: J{i + 1} by {d:g}° leaves the soft limit from any "
+                                  f"start (its range is {w:g}°)")
 
     def _car_point(self, car_point: Any, name: str) -> tuple[np.ndarray, float]:
         """(pose 4×4 m, elbow rad) of a CarPosWithElbow, else VALUE_ERR."""
