@@ -126,6 +126,26 @@ def test_pause_keeps_the_queue_and_accepts_new_motions_resume_runs_them(base, ex
     assert base.device.completed == 3
 
 
+def test_while_paused_a_continuous_move_queues_for_resume_and_a_jog_discards_nothing(
+        base, executor, trace):  # noqa: F811
+    """pause: 動作指令は廃棄されません; 一時停止状態で入力された動作指令は…resume()実行後に実行.
+    A jog or a continuous move took over the paused move: it was lost, and the base stood."""
+    ready(base)
+    first = base.move_forward(600.0).values["motion_id"]
+    trace.step(1.0)
+    assert base.pause().ok
+    trace.until(lambda: state(base) == VehicleState.PAUSED, 3.0)
+    r = base.move_jog(100.0, 0.0, 0.0)
+    assert not r.ok and "Paused" in r.comment
+    r = base.move_continuous_rel((0.0, 0.0, 90.0))
+    assert r.ok and r.values["motion_id"] == first + 1 and base.device.queue_length == 1
+    assert base.resume().ok
+    trace.until_idle()
+    trace.check()
+    assert_at(base, 600.0, 0.0, 90.0)
+    assert (base.device.completed, base.device.discarded) == (2, 0)
+
+
 def test_stop_decelerates_at_the_maximum_and_discards_everything(base, executor, trace):  # noqa: F811
     ready(base)
     base.set_velocity((600.0, 45.0))

@@ -36,6 +36,13 @@ LOOKAHEAD_STEPS = 2          # control periods ahead of now that an edit planned
 LOOKAHEAD_GROWTH = 4         # … times this for each attempt the device outran
 
 
+PAUSED = object()       # look of a take-over: the base is paused, the command queues for resume
+# a velocity drive given while paused: taking over would discard what the pause keeps for
+# resume (pause: 動作指令は廃棄されません), and queued, its deadman would end it before it ran
+PAUSED_DRIVE = ("the base is Paused: {} would discard the moves kept for resume "
+                "(resume or stop first)")
+
+
 class VehicleCore(Sensing):
     """Power, servo, state, alarms, I/O, battery, odometry and the motion queue of the base.
 
@@ -434,12 +441,16 @@ class VehicleCore(Sensing):
         limits, label = self._limits(), "move_continuous_rel"
 
         def look(device: Device, attempt: int):
+            if device.paused:
+                return PAUSED
             cur = self._running(device)
             if cur is None:
                 return None
             return cur, cur.motion.at(device.t), self._splice_time(device, cur.motion, attempt)
 
         def plan(seen):
+            if seen is PAUSED:          # kept for resume (一時停止状態で入力された動作指令は蓄積)
+                return lambda device: None
             if seen is None:
                 return self._discard_not_started
             cur, here, t = seen
@@ -491,10 +502,11 @@ class VehicleCore(Sensing):
     @planned
     def set_joystick(self, on_off: bool) -> None:
         """Joystick on: its input drives the base (within the velocity and acceleration settings).
-        Off while it drives: decelerate at the maximum acceleration, then Ready."""
+        Off while it drives: decelerate at the maximum acceleration, then Ready (while paused it
+        stays held, and its deadman ends it after resume)."""
         self.joystick = bool(on_off)
         cur = self.device.current
-        if not on_off and cur is not None and cur.label == "joystick":
+        if not on_off and cur is not None and cur.label == "joystick" and not self.device.paused:
             c = self.config
             self._drive((0.0, 0.0), 0.0, (c.accel_limit_translation / 1000.0,
                                           math.radians(c.accel_limit_rotation)), "joystick",
@@ -649,6 +661,8 @@ class VehicleCore(Sensing):
         refused), or start one on an idle base. The deadman ends it `hold` s of wall time from
         now unless called again."""
         def look(device: Device, attempt: int):
+            if device.paused:
+                raise VehicleRefused(AlarmCode.WRONG_STATE, PAUSED_DRIVE.format(label))
             cur = self._running(device)
             if not take_over and (device.queue or cur is not None and cur.label not in VELOCITY_DRIVEN):
                 raise self._busy(label)
