@@ -22,7 +22,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from acti_motion.config_fields import QUEUE_SIZE_RANGE, ranged
+from acti_motion.config_fields import QUEUE_SIZE_RANGE, check_ranges, ranged
 from acti_motion.executor import MotionExecutor
 from acti_motion.arm.kinematics import ArmKinematics, Unreachable, rotate_about
 from acti_motion.arm.poses import Frames, compose_relative, hg_to_pose, inverse, pose_to_hg
@@ -167,6 +167,7 @@ def _first_exit(values: np.ndarray, lower: np.ndarray, upper: np.ndarray,
 def _check_config(c: ArmConfig) -> None:
     """The start-up settings that have no setter, else ValueError (the node does not start);
     the others are applied through their setters (`ArmCore._apply_settings`)."""
+    check_ranges(c, "arm configuration")
     if not (math.isfinite(c.gripper_speed) and c.gripper_speed > 0):
         raise ValueError(f"gripper_speed must be finite and > 0, got {c.gripper_speed}")
 
