@@ -7,7 +7,10 @@ A table row without a handler (the ED area, for now) is dispatched to ``Host.cal
 """
 from __future__ import annotations
 
+import errno
 import io
+import os
+import stat
 import sys
 import time
 from dataclasses import dataclass
@@ -63,6 +66,25 @@ class Loopback(io.RawIOBase):
     def write(self, data) -> int:
         self.buffer.extend(data)
         return len(data)
+
+
+OPEN_FLAGS = {"r": os.O_RDONLY, "w": os.O_WRONLY | os.O_CREAT | os.O_TRUNC,
+              "a": os.O_WRONLY | os.O_CREAT | os.O_APPEND}
+
+
+def open_regular(path: Path, mode: str) -> BinaryIO:
+    """A binary stream on the regular file `path` ('r', 'w' or 'a'). Opened without blocking
+    and refused unless a regular file: a FIFO in the program directory made FOPEN wait for
+    ever, and a device would be read without end."""
+    fd = os.open(path, OPEN_FLAGS[mode] | os.O_NONBLOCK, 0o666)
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise OSError(errno.EINVAL, "not a regular file")
+        os.set_blocking(fd, True)
+        return os.fdopen(fd, mode + "b")
+    except BaseException:
+        os.close(fd)
+        raise
 
 
 def inside(root: Path | None, name: str) -> Path:
@@ -177,7 +199,7 @@ class Host:
         files of communication ports are loopbacks; OSError or StrolicError when it fails."""
         if number in self.port_files:
             return Loopback(self.port_buffers[self.port_files[number]])
-        return open(inside(self.file_root, self.file_name(number)), mode + "b")
+        return open_regular(inside(self.file_root, self.file_name(number)), mode)
 
     # robot and system functions without a handler in the opcode table
     def call(self, vm, proc, opcode) -> object:

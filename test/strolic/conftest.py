@@ -1,6 +1,7 @@
 """Helpers shared by the STROLIC tests: run a text program, get its stack or its exception."""
 from __future__ import annotations
 
+import os
 import sys
 from datetime import datetime
 from pathlib import Path
@@ -58,14 +59,16 @@ def case_host(directory: Path) -> RecordingHost:
     """The host of the case table (strolic_cases.py). Its program directory is
     ``directory/program`` (file N is ``fileN.txt``), with a subdirectory ``sub``; a symbolic link
     ``out`` leads to ``directory/outside``. File 7 is named ``../outside.txt``, 8 an absolute
-    path, 9 ``out/x.txt`` (through the link), 10 ``sub/data.txt``, 11 ``sub`` (a directory)."""
+    path, 9 ``out/x.txt`` (through the link), 10 ``sub/data.txt``, 11 ``sub`` (a directory),
+    12 ``fifo`` (a named pipe nobody writes to)."""
     host = RecordingHost()
     host.file_root = directory / "program"
     (host.file_root / "sub").mkdir(parents=True)
     (directory / "outside").mkdir()
     (host.file_root / "out").symlink_to(directory / "outside", target_is_directory=True)
+    os.mkfifo(host.file_root / "fifo")
     host.files.update({7: "../outside.txt", 8: str(directory / "outside" / "abs.txt"),
-                       9: "out/x.txt", 10: "sub/data.txt", 11: "sub"})
+                       9: "out/x.txt", 10: "sub/data.txt", 11: "sub", 12: "fifo"})
     return host
 
 
