@@ -53,7 +53,8 @@ def user_code_of(num: Num) -> int:
     else:
         value = round_half_away(num.value)
     if not is_user_code(value):
-        raise fail(K.TYPE_MISMATCH, f"{value:#x} is not a user code number")
+        shown = f"{value:#x}" if abs(value) <= 0xFFFF_FFFF else f"{num.value:g}"
+        raise fail(K.TYPE_MISMATCH, f"{shown} is not a user code number")
     return value
 
 

@@ -75,8 +75,15 @@ class OpenFile:
         self._io(self.stream.close)
 
 
+MAX_FILE_NUMBER = 0x7FFF_FFFF     # an I4: a file number beyond is no file's
+
+
 def _file_number(proc: Process) -> int:
-    return pop_count(proc)
+    number = pop_count(proc)
+    if not 1 <= number <= MAX_FILE_NUMBER:
+        shown = number if abs(number) <= MAX_FILE_NUMBER else f"{float(number):g}"
+        raise file_error(f"there is no file {shown} (file numbers are 1 … {MAX_FILE_NUMBER})")
+    return number
 
 
 def _open_file(vm: VM, proc: Process) -> OpenFile:
@@ -101,8 +108,6 @@ def fopen(vm: VM, proc: Process) -> None:
         raise file_error("open mode must be 1 (read), 2 (write) or 4 (append)")
     if number in vm.files:
         raise file_error(f"file {number} is already open")
-    if number < 1:
-        raise file_error(f"there is no file {number} (file numbers are positive)")
     try:
         stream = vm.host.open_file(number, mode)
     except OSError as error:
@@ -118,8 +123,8 @@ def fclose(vm: VM, proc: Process) -> None:
 
 def fstat(vm: VM, proc: Process) -> None:
     """FSTAT a: bit 0 end of file reached (a file open for reading), bit 1 not open, bit 2 an
-    access to it failed."""
-    file = vm.files.get(_file_number(proc))
+    access to it failed. A number no file can have is not open."""
+    file = vm.files.get(pop_count(proc))
     if file is None:
         proc.push(Num(I2, NOT_OPEN_BIT))
         return

@@ -400,11 +400,11 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
               (f"1 2 FOPEN 1 5 OUTPUT 1 FCLOSE 1 2 FOPEN {READ1} 1 FSTAT", [T]),
               ("10 2 FOPEN 10 FSTAT", [F]), ("1.4 2 FOPEN 1 FSTAT", [F]),
               ("1 1 FOPEN", FILE), ("1 3 FOPEN", FILE), ("1 2 FOPEN 1 2 FOPEN", FILE),
-              ("0 2 FOPEN", FILE), ("11 1 FOPEN", FILE), ("12 1 FOPEN", FILE),
+              ("0 2 FOPEN", FILE), ("1e308 2 FOPEN", FILE), ("11 1 FOPEN", FILE), ("12 1 FOPEN", FILE),
               ("12 2 FOPEN", FILE), ("7 2 FOPEN", OUTSIDE),
               ("8 2 FOPEN", OUTSIDE), ("9 2 FOPEN", OUTSIDE), ('"a" 2 FOPEN', TYPE)],
     "FCLOSE": [("1 2 FOPEN 1 FCLOSE 1 FSTAT", ["I2:2"]), ("1 FCLOSE", FILE)],
-    "FSTAT": [("1 FSTAT", ["I2:2"]), (f"1 2 FOPEN {READ1} 1 FSTAT", [T]),
+    "FSTAT": [("1 FSTAT", ["I2:2"]), ("0 FSTAT 1e308 FSTAT", ["I2:2", "I2:2"]), (f"1 2 FOPEN {READ1} 1 FSTAT", [T]),
               (f"1 2 FOPEN 1 7 PUTC {READ1} 1 FSTAT 1 GETC 1 FSTAT", [F, "I2:7", T]),
               ("1 2 FOPEN 1 FSTAT", [F]), ("FSTAT", UNDER)],
     "OUTPUT": [(f'1 2 FOPEN 1 5 OUTPUT 1 2.5 OUTPUT 1 "ab" OUTPUT 1 Vec(1 2 3) OUTPUT '
