@@ -79,6 +79,22 @@ def test_cruise_to_a_point_behind_turns_first_and_queues_after_other_moves(base,
     assert math.dist((x, y), (0.0, 300.0)) < 5.0
 
 
+@pytest.mark.parametrize("added_while", ["queued", "cruising"])
+def test_a_point_that_reverses_the_path_stops_there_and_goes_back(base, executor, added_while):  # noqa: F811
+    """A point straight back along the path is a cusp no differential drive passes: the base
+    stops at the point before, turns and goes on (it went Stuck, the cruise not completed)."""
+    ready(base)
+    assert base.move_cruise_abs((1000.0, 0.0)).ok
+    if added_while == "cruising":
+        steps(executor, 2.0)
+    assert base.move_cruise_abs((0.0, 0.0)).ok
+    trace = record(executor, base)
+    assert not base.stuck and not base.alarms.active()
+    assert math.dist(trace[-1][:2], (0.0, 0.0)) < 5.0
+    assert max(x for x, *_ in trace) == pytest.approx(1000.0, abs=10.0)
+    assert (base.device.completed, base.device.discarded) == (2, 0)
+
+
 @pytest.mark.parametrize("point", [(math.nan, 0.0), (0.0, math.inf)])
 def test_cruise_refuses_bad_points(base, point):
     ready(base)

@@ -32,6 +32,7 @@ SPLINE_KEEP = 2000           # samples of it handed to TOPP-RA's interpolator
 GRID_STEP = 0.01             # m between TOPP-RA grid points …
 GRID_MAX = 600               # … at most this many
 MIN_SEPARATION = 1e-3        # m: closer points are one point
+CUSP_TURN = math.radians(30.0)   # heading change between two dense samples: the path doubles back
 WINDOW = 2                   # points before a new cruise point that are planned again with it
 LET_DOWN = 0.8               # a start above v_max is let down at this share of a_max (slack for TOPP-RA)
 RETIME_SAMPLES = 400         # samples of the rest of a cruise path timed again (more: a noisier heading)
@@ -76,7 +77,9 @@ def spline_through(start: Pose2D, points: Sequence[tuple[float, float]], curvatu
     along the start heading with the given curvature (1/m; so the yaw rate goes on without a
     jump where it takes over from a running path) and ending straight: (arc length s, x, y,
     heading, arc length of each point); None if no point is farther than MIN_SEPARATION from
-    the one before."""
+    the one before, or where the path doubles back on itself (a point that reverses the
+    direction: a cusp no differential drive passes without stopping; the caller then stops
+    there and starts a new path)."""
     xy = [(start.x, start.y)]
     index = []                                   # per given point: its row in xy
     for p in points:
@@ -96,6 +99,8 @@ def spline_through(start: Pose2D, points: Sequence[tuple[float, float]], curvatu
     speed = np.linalg.norm(d, axis=1)
     s = np.concatenate([[0.0], np.cumsum((speed[1:] + speed[:-1]) / 2 * np.diff(uu))])
     heading = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+    if len(heading) > 1 and np.max(np.abs(np.diff(heading))) > CUSP_TURN:
+        return None
     heading += start.theta - heading[0]          # the spline leaves along the heading exactly
     s_points = [float(np.interp(u[i], uu, s)) for i in index]
     return s, pos[:, 0], pos[:, 1], heading, s_points
