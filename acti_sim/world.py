@@ -22,6 +22,7 @@ WHEEL_JOINTS = ("left_wheel_joint", "right_wheel_joint")
 BUMPER_LINK = "bumper"
 CASTER_LINKS = ("front_caster", "rear_caster")
 
+HELD = "held"                          # the wheels' motor target while `hold_wheels`
 
 class PhysicsClient:
     """PyBullet's functions bound to one physics client. pybullet_utils' BulletClient binds them
@@ -94,7 +95,7 @@ class World:
         self._movable_names = [p.getJointInfo(self.robot, j)[1].decode() for j in self._movable]
         self.reset_arm(np.zeros(len(ARM_JOINTS)))
         self.set_gripper_target(0.0)
-        self._wheel_target: tuple[float, float] | None = None
+        self._wheel_target: tuple[float, float] | str | None = None
         self.set_wheel_velocities(0.0, 0.0)
         self.wheel_radius = 0.10
         self.wheel_separation = 0.50
@@ -191,6 +192,17 @@ class World:
         self._p.setJointMotorControlArray(
             self.robot, self._wheel_ids, pybullet.VELOCITY_CONTROL,
             targetVelocities=[left, right], forces=[eff, eff])
+
+    def hold_wheels(self) -> None:
+        """Hold the wheels where they are (a base at rest): a velocity motor at 0 let them creep
+        (0.03 rad in 2 min, the base yawing 0.3°); the next `set_wheel_velocities` drives again."""
+        if self._wheel_target == HELD:
+            return
+        self._wheel_target = HELD
+        eff = self.limits[WHEEL_JOINTS[0]].effort
+        self._p.setJointMotorControlArray(
+            self.robot, self._wheel_ids, pybullet.POSITION_CONTROL,
+            targetPositions=self.wheel_positions().tolist(), forces=[eff, eff])
 
     def wheel_positions(self) -> np.ndarray:
         """Unwrapped wheel angles (rad): PyBullet reports continuous joints without wrapping."""

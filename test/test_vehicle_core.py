@@ -4,6 +4,7 @@ import math
 
 import pytest
 
+from acti_motion.arm.core import ArmConfig, ArmCore
 from acti_motion.vehicle.paths import TrackedBaseMotion
 from acti_motion.vehicle.core import VehicleState
 from sim_fixtures import executor, run_until  # noqa: F401
@@ -144,6 +145,20 @@ def test_while_paused_a_continuous_move_queues_for_resume_and_a_jog_discards_not
     trace.check()
     assert_at(base, 600.0, 0.0, 90.0)
     assert (base.device.completed, base.device.discarded) == (2, 0)
+
+
+def test_a_base_at_rest_holds_its_pose(base, executor):  # noqa: F811
+    """With the arm held on it, as in the main job: the wheels' velocity motors at 0 let the
+    base creep (its heading 0.34° in 2 min, odometry along); at rest the wheels are held."""
+    assert ArmCore(executor, ArmConfig()).servo_on().ok
+    ready(base)
+    steps(executor, 1.0)
+    x0, y0, yaw0 = executor.world.base_pose()
+    odometry0 = position(base)
+    steps(executor, 60.0)
+    x1, y1, yaw1 = executor.world.base_pose()
+    assert math.dist((x0, y0), (x1, y1)) < 2e-4 and abs(math.degrees(yaw1 - yaw0)) < 0.01
+    assert position(base) == pytest.approx(odometry0, abs=0.2)
 
 
 def test_stop_decelerates_at_the_maximum_and_discards_everything(base, executor, trace):  # noqa: F811

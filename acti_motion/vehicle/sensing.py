@@ -29,7 +29,7 @@ class Sensing:
         """Each step before the devices move: odometry, battery, contact, blockage, deadman."""
         self.odometry.update(world.wheel_positions(), self._dt)
         if self.device.current is None:
-            world.set_wheel_velocities(0.0, 0.0)
+            world.hold_wheels()
         self._drain_battery()
         self._contact = contact = world.bumper_in_contact()
         if not contact:
