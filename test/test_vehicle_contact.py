@@ -35,7 +35,11 @@ def test_contact_locks_the_base_until_unlock(base, executor, wall):  # noqa: F81
     assert (AlarmCode.CONTACT, 1) in [(a[0], a[1]) for a in alarms]       # a FAULT
     r = base.move_forward(-200.0)
     assert not r.ok and "Locked" in r.comment and "unlock" in r.comment
+    r = base.move_jog(-100.0, 0.0, 0.0)                         # the servo is on: not the reason
+    assert not r.ok and "needs it unlocked (call unlock)" in r.comment, r.comment
     assert base.clear_alarm().ok and state(base) == VehicleState.LOCKED  # clear_alarm is not unlock
+    alarms = base.get_active_alarm(5).values["active_alarms"]
+    assert (AlarmCode.CONTACT, 1) in [(a[0], a[1]) for a in alarms]       # … and says why
     assert base.unlock().ok and state(base) == VehicleState.READY
     assert base.move_forward(-200.0).ok                                   # back away
     settle(executor, base)

@@ -181,8 +181,9 @@ class VehicleCore(Sensing):
     def clear_alarm(self) -> None:
         """Clear every alarm (1.4.1: 発生した全てのアラームを解除). One whose cause is still there
         is raised again at once: a battery still within its hysteresis band of the level. Stuck
-        ends; Locked is a state that only unlock leaves."""
-        self.alarms.clear(*Kind)
+        ends; Locked is a state that only unlock leaves, and its contact fault stays with it (a
+        client would see a locked base with no alarm to say why)."""
+        self.alarms.clear(*(k for k in Kind if not (k is Kind.CONTACT and self.locked)))
         self.stuck = False
         self._check_battery(self.battery.voltage)
 
@@ -554,7 +555,9 @@ class VehicleCore(Sensing):
 
     def _refuse_unless(self, s: VehicleState, allowed: tuple[VehicleState, ...], operation: str) -> None:
         if s not in allowed:
-            need = "Ready" if allowed == IDLE else "the servo on"
+            need = ("Ready" if allowed == IDLE
+                    else "it unlocked" if s == VehicleState.LOCKED
+                    else "no active alarm" if s == VehicleState.ALARM else "the servo on")
             raise VehicleRefused(AlarmCode.WRONG_STATE,
                                  f"the base is {STATE_STRINGS[s]}: {operation} needs {need}"
                                  + self._how_to_leave(s))
