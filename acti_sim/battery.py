@@ -51,6 +51,12 @@ class VoltageLevel:
         self.level, self.band = level, band
         self.tripped = False
 
+    def describe(self, voltage: float) -> str:
+        """Why the level is tripped at this voltage (below it, or not yet back above its band)."""
+        if voltage < self.level:
+            return f"{voltage:.2f} V (below {self.level:g} V)"
+        return f"{voltage:.2f} V (tripped below {self.level:g} V, released at {self.level + self.band:g} V)"
+
     def update(self, voltage: float) -> bool:
         """Whether the level is tripped at this voltage."""
         if voltage < self.level:

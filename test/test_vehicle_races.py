@@ -118,7 +118,11 @@ def test_the_battery_fault_does_not_end_when_the_load_drops(base, executor):  # 
     assert base.battery.voltage > c.battery_cutoff_voltage       # the load dropped …
     assert base.clear_alarm().ok
     assert state_msg(base) == "Alarm-201"                       # … the fault stays
-    assert not base.set_power(True).ok or not base.set_servo(True).ok
+    released = c.battery_cutoff_voltage + c.battery_hysteresis
+    alarm = base.get_active_alarm(1).values["active_alarms"][0]
+    assert f"released at {released:g} V" in alarm[2], alarm      # not "44.1 V (below 44 V)"
+    r = base.set_servo(True)
+    assert not r.ok and f"back at {released:g} V" in r.comment, r.comment
     base.battery.charge = 1.0
     assert base.clear_alarm().ok and base.set_servo(True).ok and state(base) == VehicleState.READY
 

@@ -163,11 +163,20 @@ class VehicleCore(Sensing):
             alarm = self.alarms.first(AlarmType.FAULT)
             raise VehicleRefused(AlarmCode.WRONG_STATE,
                                  f"alarm {alarm.code} is active ({alarm.source}): the servo stays "
-                                 "off until clear_alarm / unlock")
+                                 f"off until {self._remedy(alarm.code)}")
         if not on_off:
             self.servo = False       # before the stop: a plan that commits after it sees it
             self._stop()
         self.servo = bool(on_off)
+
+    def _remedy(self, code: int) -> str:
+        """What ends a fault: unlock for a contact, a charged battery for the cut-off."""
+        if code == AlarmCode.CONTACT:
+            return "unlock"
+        if code == AlarmCode.BATTERY_EMPTY:
+            level = self._battery_empty
+            return f"the battery is back at {level.level + level.band:g} V and clear_alarm is called"
+        return "clear_alarm"
 
     @query
     def get_servo_status(self, axisid: int) -> dict:

@@ -108,16 +108,15 @@ class Sensing:
     def _check_battery(self, voltage: float) -> None:
         """Raise the battery alarms whose level is tripped (with hysteresis); the cut-off one
         also turns the servo off."""
-        c = self.config
         if self._battery_low.update(voltage) and not self.alarms.has(AlarmCode.BATTERY_LOW):
             self.alarms.raise_(AlarmCode.BATTERY_LOW,
-                               f"battery low: {voltage:.1f} V (below {c.battery_low_voltage:g} V)",
+                               f"battery low: {self._battery_low.describe(voltage)}",
                                Kind.CONDITION)
         if self._battery_empty.update(voltage) and not self.alarms.has(AlarmCode.BATTERY_EMPTY):
             with self.lock:
                 self.alarms.raise_(AlarmCode.BATTERY_EMPTY,
-                                   f"battery exhausted: {voltage:.1f} V (below "
-                                   f"{c.battery_cutoff_voltage:g} V): servo off", Kind.CONDITION)
+                                   f"battery exhausted: {self._battery_empty.describe(voltage)}: "
+                                   "servo off", Kind.CONDITION)
                 if self.servo:
                     self.servo = False
                     self._stop()
