@@ -260,6 +260,9 @@ def test_set_position_redefines_the_origin(base, executor):  # noqa: F811
     settle(executor, base)
     x, y, th = base.get_position().values["pos"]
     assert abs(x - 1000.0) < 5 and abs(y + 200.0) < 5 and abs(th - 90.0) < 0.5
+    for given, read in ((200.0, -160.0), (-300.0, 60.0)):     # wrapped at once, not a step later
+        assert base.set_position((0.0, 0.0, given)).ok
+        assert base.get_position().values["pos"][2] == pytest.approx(read)
 
 
 def test_set_position_while_moving_keeps_the_path_on_the_floor(base, executor):  # noqa: F811

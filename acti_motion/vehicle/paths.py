@@ -100,7 +100,10 @@ class Odometry:
         self.covariance = moved @ self.covariance @ moved.T + by_wheels @ wheel_var @ by_wheels.T
 
     def reset(self, pose: Pose2D) -> Pose2D:
-        """Redefine the pose; returns the transform from the old frame to the new one."""
+        """Redefine the pose (its heading wrapped to ±π, as every pose odometry reports: 200°
+        read 200 until the next step made it −160); returns the transform from the old frame
+        to the new one."""
+        pose = Pose2D(pose.x, pose.y, wrap_angle(pose.theta))
         with self.lock:
             old, self.pose = self.pose, pose
             moved = pose.compose(old.inverse())
