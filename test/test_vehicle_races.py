@@ -82,6 +82,8 @@ def test_pause_of_an_idle_base_is_visible_and_resume_leaves_it(base):
     ready(base)
     assert base.pause().ok and state(base) == VehicleState.PAUSED
     assert base.resume().ok and state(base) == VehicleState.READY
+    r = base.resume()                                          # nothing paused: true, and said
+    assert r.ok and r.comment == "ignored: the base is not paused"
 
 
 # --- clear_alarm (1.4.1: 発生した全てのアラームを解除) --------------------------------------

@@ -324,8 +324,11 @@ class VehicleCore(Sensing):
         return None
 
     @command
-    def resume(self) -> None:
-        self.device.resume(self._resume_ramp())
+    def resume(self) -> Reply | None:
+        """Leave a pause (the spec: always true); one that finds no pause says so, as pause does."""
+        if not self.device.resume(self._resume_ramp()):
+            return Reply(comment="ignored: the base is not paused")
+        return None
 
     @command
     def stop(self) -> None:
