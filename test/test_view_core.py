@@ -155,6 +155,9 @@ def test_live_view_poses_the_robot_at_its_rate_for_a_connected_page(robot):
             assert wait_until(lambda: view.frames >= frames0 + 50, 10.0)
             rate = (view.frames - frames0) / (time.monotonic() - t0)
             count = len(received)
+            # a robot at rest sends nothing new (POSE_STEP): move the arm
+            assert arm.servo_on().ok and arm.set_speed_joint(50).ok
+            assert arm.move_ptp_joint_rel([20.0] + [0.0] * 6).ok
             assert wait_until(lambda: len(received) > count, 5.0), "no poses reach the page"
         assert rate >= 20.0, f"{rate:.1f} Hz"
     finally:
