@@ -36,6 +36,20 @@ def test_ik_honours_the_arm_angle_and_keeps_the_pose(kin, psi_deg):
     assert abs(wrap(kin.arm_angle(q) - math.radians(psi_deg))) < 1e-8
 
 
+@pytest.mark.parametrize("taught", [
+    (0, 30, 0, -60, 30, -2, -20),     # J6 just below 0 (the start's is +60)
+    (0, 30, 20, 2, -30, 60, 0),       # J4 just above 0 (the start's is −60)
+    (30, -2, -20, -90, 0, 45, 0),     # J2 just below 0 (the start's is +30)
+])
+def test_the_nearest_solution_is_taken_across_a_branch_boundary(kin, taught):
+    """A pose taught with J2, J4 or J6 near 0 on the other side of the start's sign: its twin
+    with the start's sign has the joints beside it half a turn away (a wrist or shoulder flip)."""
+    q = np.radians(taught)
+    start = np.radians([0, 30, 0, -60, 0, 60, 0])
+    got = kin.solve(kin.flange(q), start, psi=kin.arm_angle(q))
+    assert np.degrees(np.max(np.abs(got - q))) < 1e-6, np.round(np.degrees(got), 3)
+
+
 def test_start_posture_reports_elbow_zero_and_flags(kin):
     assert math.degrees(kin.arm_angle(START)) == pytest.approx(0.0, abs=1e-9)
     assert kin.flags(START) == 0

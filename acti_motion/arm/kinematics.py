@@ -281,8 +281,10 @@ class ArmKinematics:
         n = n / np.linalg.norm(n)
         elbow = self.shoulder + h * u + rho * n
         # All eight branches at once, the reference's signs of θ2, θ4, θ6 first. When none of
-        # the reference's is near zero and the first branch within the limits has its signs, that
-        # one is the nearest and it is taken; else the nearest of those within the limits.
+        # the reference's nor the first in-limit branch's is near zero and that branch has the
+        # reference's signs, it is the nearest and it is taken; else the nearest of those within
+        # the limits (a target near θ6 = 0 on the other side has a same-sign twin with θ5 and
+        # θ7 half a turn away: taking it swung the wrist 180°).
         signs = BRANCH_SIGNS * np.where(ref[1::2] < 0, -1.0, 1.0)
         q, inside = self._nearest_turns(
             self._branch_many(np.broadcast_to(elbow, (8, 3)), np.broadcast_to(w, (8, 3)),
@@ -292,6 +294,7 @@ class ArmKinematics:
             raise Unreachable("no joint solution within the joint limits for this pose and elbow")
         first = valid[0]
         if (min(abs(ref[1]), abs(ref[3]), abs(ref[5])) > CLEAR
+                and min(abs(q[first, 1]), abs(q[first, 3]), abs(q[first, 5])) > CLEAR
                 and np.all(np.sign(q[first, 1::2]) == np.sign(ref[1::2]))):
             best = q[first]
         else:
