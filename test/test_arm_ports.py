@@ -354,7 +354,8 @@ def test_settings_refused_while_moving(arm, executor):  # noqa: F811
     assert r.code == R.STATUS_ERR and "moves" in r.comment
     r = arm.set_control_point_offset(IDENTITY)
     assert r.code == R.STATUS_ERR
-    assert arm.set_base_offset(IDENTITY).ok          # the spec lists no STATUS_ERR for it
+    r = arm.set_base_offset(IDENTITY)                 # the spec lists no STATUS_ERR for it: NG
+    assert r.code == R.NG and "queued" in r.comment
 
 
 @pytest.mark.parametrize("field, value", [

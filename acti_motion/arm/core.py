@@ -488,7 +488,14 @@ class ArmCore:
 
     @returns(*SETTER)
     def set_base_offset(self, offset: list[float]) -> None:
+        """NG (the spec lists no STATUS_ERR for it) while anything runs, is paused mid-move or
+        is queued: their targets were given in the present robot frame, and a queued move ended
+        100 mm from where the new frame said it should."""
         base = _offset(offset, BASE_OFFSET_MM, ReturnCode.VALUE_ERR)
+        if self.device.busy:
+            raise Refused(R.NG, "set_base_offset is refused while a motion is running, paused "
+                                "or queued: their targets are in the present robot frame "
+                                "(wait or stop first)")
         self.frames = Frames(base, self.frames.tool)
 
     @returns(R.STATUS_ERR)
