@@ -65,6 +65,7 @@ MAX_ACCEL_TIME_S = 10.0
 # two of its own cycles
 MIN_ACCEL_TIME_S = 0.001
 MIN_SPEED_JOINT_DEG_S = 0.1
+RATED_ROUNDING_DEG_S = 5e-4   # a rated speed given as shown to 0.001°/s (get_max_speed_joint)
 SPEED_TRANSLATION_MM_S = (1.0, 10000.0)
 SPEED_ROTATION_DEG_S = (0.1, 3600.0)
 SOFT_LIMIT_CARTESIAN_MM = 100000.0       # |limit|: a box of 200 m holds every reachable point
@@ -444,13 +445,16 @@ class ArmCore:
 
     @returns(*SETTER)
     def set_max_speed_joint(self, speed: list[float]) -> None:
+        """Each within 0.1°/s … the joint's rated speed, as rounded to 0.001°/s (the URDF's
+        2.35619 rad/s is 134.9997°/s: 135, the rating it stands for, was refused); a value
+        within that rounding is the rated speed."""
         v = finite_vector(speed, self.axis_count, "speed")
         for i, (x, hw) in enumerate(zip(v, self.hard_max_speed_joint)):
-            if not MIN_SPEED_JOINT_DEG_S <= x <= hw + 1e-9:
+            if not MIN_SPEED_JOINT_DEG_S <= x <= hw + RATED_ROUNDING_DEG_S:
                 raise value_error(f"speed[{i}] (J{i + 1}) is {x:g}°/s: it must be at least "
                                   f"{MIN_SPEED_JOINT_DEG_S:g}°/s and at most the joint's rated "
                                   f"{hw:.3f}°/s")
-        self.max_speed_joint = v
+        self.max_speed_joint = np.minimum(v, self.hard_max_speed_joint)
 
     @returns(*SETTER)
     def set_max_speed_cartesian(self, speed: tuple) -> None:
