@@ -401,3 +401,11 @@ def test_feedback_pose_is_kept_at_rest_and_follows_a_move(arm, executor):  # noq
         poses.append(arm.get_feedback_pos_cartesian().values["pos"][0])
     assert all(a != b for a, b in zip(poses, poses[1:]))
     assert poses[-1][7] != pytest.approx(rest[0][7], abs=1e-3)      # y: J1 turned
+
+
+def test_a_refusal_shows_the_value_as_given_not_rounded_into_the_limit(arm):
+    """J1 = 170.0001 read "J1 = 170° is outside the soft limit [-170, 170]°"."""
+    ready(arm)
+    hi = float(arm.soft_limit_joint[0, 1])
+    r = arm.move_ptp_joint_abs([hi + 1e-4, 30.0, 0.0, -60.0, 0.0, 60.0, 0.0])
+    assert r.code == R.VALUE_ERR and f"J1 = {hi + 1e-4:.10g}°" in r.comment, r.comment

@@ -731,7 +731,7 @@ class ArmCore:
         lo, hi = self.soft_limit_joint[:, 0].tolist(), self.soft_limit_joint[:, 1].tolist()
         for i, (q, a, b) in enumerate(zip(np.asarray(goal_deg, float).tolist(), lo, hi)):
             if not a - 1e-9 <= q <= b + 1e-9:
-                raise value_error(f"{name}: J{i + 1} = {q:g}° is outside the soft limit "
+                raise value_error(f"{name}: J{i + 1} = {q:.10g}° is outside the soft limit "
                                   f"[{a:g}, {b:g}]°")
 
     def _check_joint_step(self, step_deg: np.ndarray, name: str) -> None:
@@ -780,7 +780,7 @@ class ArmCore:
             k, axis = hit
             where = "the target" if k == len(positions_mm) - 1 else "the path"
             raise value_error(f"{label}: {where} leaves the Cartesian soft limit: "
-                              f"{'xyz'[axis]} = {positions_mm[k, axis]:.2f} mm, limit "
+                              f"{'xyz'[axis]} = {positions_mm[k, axis]:.10g} mm, limit "
                               f"[{lim[axis, 0]:g}, {lim[axis, 1]:g}] mm")
 
     def _check_joint_path(self, qs_deg: np.ndarray, label: str) -> None:
@@ -789,7 +789,7 @@ class ArmCore:
         if hit is not None:
             k, j = hit
             raise value_error(f"{label}: the path leaves the joint soft limit: J{j + 1} = "
-                              f"{qs_deg[k, j]:.3f}°, limit [{lim[j, 0]:g}, {lim[j, 1]:g}]°")
+                              f"{qs_deg[k, j]:.10g}°, limit [{lim[j, 0]:g}, {lim[j, 1]:g}]°")
 
     # === queueing ======================================================================================
     def queue_joint_move(self, goal_of: Callable[[ArmSetpoint], np.ndarray], label: str,
