@@ -70,8 +70,7 @@ class MotionActions:
             goal_handle.publish_feedback(WaitMotion.Feedback(
                 current_motion_id=motion_id, current_label=label, progress=progress,
                 queue_length=queued))
-        out = await wait_for_motion(goal_handle, self.core.device, self.watch,
-                                    "stop, servo off or an alarm", feedback)
+        out = await wait_for_motion(goal_handle, self.core.device, self.watch, feedback)
         code = (ReturnCode.VALUE_ERR if out.bad_goal else
                 ReturnCode.NG if out.aborted else ReturnCode.OK)
         result = WaitMotion.Result(motion_id=out.motion_id, completed=out.completed,

@@ -31,6 +31,7 @@ class Motion(Protocol):
 
 
 STALE = object()       # Device.edit_planned: the plan came too late, plan again
+STOPPED = "stop"       # why a stop discards, unless its caller says
 
 
 @dataclass
@@ -69,7 +70,9 @@ class Device:
         self.retired_id = 0
         self.completed = 0
         self.discarded = 0
-        self._discarded_ids: deque[tuple[int, int]] = deque(maxlen=256)
+        # (first id, last id, why) of what stops, halts and take-overs discarded
+        self._discarded_ids: deque[tuple[int, int, str]] = deque(maxlen=256)
+        self._reason = STOPPED      # why the present stop discards (a motion arriving meanwhile)
         self._retire_listeners: list[Callable[[], None]] = []
 
     # --- called by cores (any thread) -------------------------------------------------------
@@ -149,7 +152,7 @@ class Device:
             self._set_rate(1.0, ramp)
             return True
 
-    def stop(self, ramp: float) -> None:
+    def stop(self, ramp: float, reason: str = STOPPED) -> None:
         """Discard the queue, clear a pause and decelerate the current motion over `ramp` seconds.
 
         The rate falls linearly, so the motion's clock advances rate² · ramp / 2 more seconds: the
@@ -158,6 +161,7 @@ class Device:
         now, so the clock never jumps to a rest point meant for another ramp.
         """
         with self.lock:
+            self._reason = reason
             self._discard_pending()
             cur = self.current
             if cur is None:
@@ -212,16 +216,18 @@ class Device:
                 return out
         return STALE
 
-    def discard_queue(self) -> None:
+    def discard_queue(self, reason: str = STOPPED) -> None:
         """Discard the queued motions (not the current one), for an edit that changes where the
         current one ends; the lock must be held (call it from an edit)."""
         self.generation += 1
+        self._reason = reason
         self._retire_queue()
 
-    def halt(self, rest: Any) -> None:
+    def halt(self, rest: Any, reason: str) -> None:
         """Discard the current motion and the queue at once and rest at `rest` (where the device
         is, as measured): for a device that cannot follow its plan (blocked, a contact)."""
         with self.lock:
+            self._reason = reason
             self._discard_pending()
             if self.current is not None:
                 self._finish(discarded=True)
@@ -230,12 +236,12 @@ class Device:
             self.hold = self.queued_end = rest
             self.changed.notify_all()
 
-    def renumber(self, entry: QueuedMotion) -> int:
+    def renumber(self, entry: QueuedMotion, reason: str) -> int:
         """(lock held) The running motion `entry`, taken over by a command with another goal,
         goes on as that command's motion: its old id retires as discarded (it never reached its
         end, so a wait on it says not completed) and it runs on under a new id, returned."""
         self.discarded += 1
-        self._discarded_ids.append((entry.id, entry.id))
+        self._discarded_ids.append((entry.id, entry.id, reason))
         self.retired_id = max(self.retired_id, entry.id)
         self.last_id += 1
         entry.id = self.last_id
@@ -258,9 +264,15 @@ class Device:
         self._retire_listeners.append(fn)
 
     def was_discarded(self, motion_id: int) -> bool:
-        """True when motion `motion_id` was discarded by a stop (of the last 256 stops)."""
+        """True when motion `motion_id` was discarded (by one of the last 256 stops, halts or
+        take-overs)."""
+        return self.discard_reason(motion_id) is not None
+
+    def discard_reason(self, motion_id: int) -> str | None:
+        """Why motion `motion_id` was discarded ("stop", "servo off" …), None if it was not."""
         with self.lock:
-            return any(lo <= motion_id <= hi for lo, hi in self._discarded_ids)
+            return next((why for lo, hi, why in reversed(self._discarded_ids)
+                         if lo <= motion_id <= hi), None)
 
     def status(self) -> tuple[int, str, float, int]:
         """(current motion id or 0, its label, its completed fraction, motions queued behind)."""
@@ -321,6 +333,7 @@ class Device:
         cur = self.current
         what = f"motion {cur.id} ({cur.label}) failed at {t0:.3f} s" if cur else "a step failed"
         _log.error(f"{self.name}: {what}, discarded with the queue: {type(error).__name__}: {error}")
+        self._reason = f"a failure of {cur.label if cur else 'a step'}"
         self._discard_pending()
         if cur is not None:
             self.t = t0
@@ -337,7 +350,7 @@ class Device:
         self.retired_id = max(self.retired_id, self.current.id)
         if discarded:
             self.discarded += 1
-            self._discarded_ids.append((self.current.id, self.current.id))
+            self._discarded_ids.append((self.current.id, self.current.id, self._reason))
             self._stop_at = None
             self.rate = self._rate_target = 1.0
         else:
@@ -361,7 +374,7 @@ class Device:
         """A new id, retired at once as discarded (a stop overtook it)."""
         self.last_id += 1
         self.discarded += 1
-        self._discarded_ids.append((self.last_id, self.last_id))
+        self._discarded_ids.append((self.last_id, self.last_id, self._reason))
         self.retired_id = max(self.retired_id, self.last_id)
         self.changed.notify_all()
         return self.last_id
@@ -375,7 +388,7 @@ class Device:
     def _retire_queue(self) -> None:
         if self.queue:
             self.discarded += len(self.queue)
-            self._discarded_ids.append((self.queue[0].id, self.queue[-1].id))
+            self._discarded_ids.append((self.queue[0].id, self.queue[-1].id, self._reason))
             self.retired_id = max(self.retired_id, self.queue[-1].id)
             self.queue.clear()
             self.changed.notify_all()

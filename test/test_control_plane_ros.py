@@ -147,7 +147,7 @@ def test_goals_beyond_the_bound_are_rejected_and_stop_is_answered_while_the_rest
     for handle in base_accepted:
         status, result = base_wait.result(handle)
         assert status == GoalStatus.STATUS_SUCCEEDED and not result.completed
-        assert "discarded by" in result.message
+        assert result.message == "discarded: stop", result.message
     # the slots are free again
     assert arm_wait.offer(motion_id=0).accepted and base_wait.offer(motion_id=0).accepted
 

@@ -49,7 +49,7 @@ def test_halt_discards_the_current_and_queued_motions_at_once():
     d.tick(None, 0.5)                                       # "a" runs
     assert d.moving and d.queue_length == 2
     generation = d.generation
-    d.halt(0.42)
+    d.halt(0.42, "blocked")
     assert not d.busy and d.retired_id == 3 and d.discarded == 3
     assert d.hold == d.queued_end == 0.42 and d.generation == generation + 1
     assert d.submit(lambda s: Ramp1D(s, 1.0, 1.0), "d") == 4 and d.queued_end == 1.42

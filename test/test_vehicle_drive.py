@@ -81,6 +81,7 @@ def test_jog_takes_over_a_running_move_with_continuous_speed(base, executor):  #
     assert r.ok and base.device.current.label == "move_jog"
     # the move never reaches its goal: over, not completed; the jog is a motion of its own …
     assert base.device.is_over(forward) and base.device.was_discarded(forward)
+    assert base.device.discard_reason(forward) == "taken over by move_jog"
     assert r.values["motion_id"] == forward + 1
     assert base.move_jog(-100.0, 0.0, 0.0).values["motion_id"] == forward + 1   # … kept by jogs
     run_until(executor, lambda: speeds.append(base.odometry.v) or base.odometry.v < -0.09, 5.0)

@@ -139,6 +139,7 @@ def test_a_move_into_a_wall_ends_stuck_and_not_completed(base, executor, distanc
     settle(executor, base, 10.0)
     assert state(base) == VehicleState.STUCK
     assert base.device.was_discarded(motion)                    # not completed (a brake ran)
+    assert base.device.discard_reason(motion).startswith("a blockage: the base")   # and why
     assert position(base)[0] < 60.0
     assert AlarmCode.STUCK in [a[0] for a in base.get_active_alarm(5).values["active_alarms"]]
     back = base.move_forward(-100.0).values["motion_id"]       # backs away

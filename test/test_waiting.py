@@ -48,7 +48,7 @@ def wait(ros):
     def run(device, goal, cancel=False, feedback=None, period=0.01):
         watch = device_watch(ros.node, device, period)
         task = ros.executor.create_task(wait_for_motion(
-            Handle(goal, cancel), device, watch, "stop", feedback or (lambda *status: None)))
+            Handle(goal, cancel), device, watch, feedback or (lambda *status: None)))
         assert ros.wait(task, 10.0), "the wait never ended"
         return task.result()
     return run
@@ -78,12 +78,15 @@ def test_cancel_ends_the_wait_only(wait):
     assert out.end == "canceled" and d.queue_length == 1
 
 
-def test_discarded_motion_is_reported_not_completed(wait):
+def test_discarded_motion_is_reported_not_completed_with_why(wait):
     d = device_with(2)
     d.stop(0.1)
     out = wait(d, Goal(0))
     assert out.end == "succeed" and out.motion_id == 2
-    assert not out.completed and out.message == "discarded by stop"
+    assert not out.completed and out.message == "discarded: stop"
+    d = device_with(2)
+    d.stop(0.1, "servo off")
+    assert wait(d, Goal(2)).message == "discarded: servo off"
 
 
 def test_completed_motion_is_announced_by_the_device_at_once(wait):

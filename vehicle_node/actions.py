@@ -37,9 +37,7 @@ class WaitMotionServer:
                                              progress=progress, queue_length=queued)
             fill(msg, self.core.get_position().values)
             goal_handle.publish_feedback(msg)
-        out = await wait_for_motion(goal_handle, self.core.device, self.watch,
-                                    "stop, servo or power off, contact, blockage or fault",
-                                    feedback)
+        out = await wait_for_motion(goal_handle, self.core.device, self.watch, feedback)
         result = VehicleWaitMotion.Result(motion_id=out.motion_id, completed=out.completed,
                                           success=not out.aborted, message=out.message)
         fill(result, self.core.get_position().values)

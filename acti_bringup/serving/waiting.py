@@ -148,7 +148,7 @@ class WaitOutcome:
 Feedback = Callable[[int, str, float, int], None]
 
 
-async def wait_for_motion(goal_handle: Any, device: Device, watch: Watch, discarded_by: str,
+async def wait_for_motion(goal_handle: Any, device: Device, watch: Watch,
                           feedback: Feedback) -> WaitOutcome:
     """Wait for goal.motion_id (0: everything queued now) with goal.timeout (0: no limit),
     calling feedback(current id, label, progress, queue length) every tick of `watch`."""
@@ -165,9 +165,9 @@ async def wait_for_motion(goal_handle: Any, device: Device, watch: Watch, discar
 
     def outcome() -> WaitOutcome | None:
         if device.is_over(target):
-            completed = not device.was_discarded(target)
-            return WaitOutcome(target, "succeed", completed,
-                               message="" if completed else f"discarded by {discarded_by}")
+            why = device.discard_reason(target)
+            return WaitOutcome(target, "succeed", why is None,
+                               message="" if why is None else f"discarded: {why}")
         if goal_handle.is_cancel_requested:
             return WaitOutcome(target, "canceled", message="canceled: the motion goes on")
         if time.monotonic() > deadline:

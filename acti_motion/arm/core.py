@@ -23,7 +23,7 @@ from typing import Any, Callable
 import numpy as np
 
 from acti_motion.config_fields import QUEUE_SIZE_RANGE, check_ranges, ranged
-from acti_motion.executor import MotionExecutor
+from acti_motion.executor import STOPPED, MotionExecutor
 from acti_motion.arm.kinematics import ArmKinematics, Unreachable, rotate_about
 from acti_motion.arm.poses import Frames, compose_relative, hg_to_pose, inverse, pose_to_hg
 from acti_motion.profiles import Trapezoid
@@ -283,7 +283,7 @@ class ArmCore:
                           f"left [{lim[0]:g}, {lim[1]:g}] mm")
         with self._alarm_lock:
             self._alarms.append(alarm)
-        self.stop_motion(fastest=True)
+        self.stop_motion(fastest=True, reason=f"alarm 0x{alarm.code:X} ({alarm.description})")
 
     def _within_watch_limits(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Joint values (degree) and control-point position (mm) of set-point q, and which of
@@ -307,7 +307,7 @@ class ArmCore:
         """All axes off; a moving arm stops first (the brakes then hold it where it stopped).
         New motions are refused at once; the state word keeps bit 0x01 until the arm is at rest."""
         self.servo = False
-        self.stop_motion()
+        self.stop_motion(reason="servo off")
 
     @returns(*GETTER)
     def get_state(self) -> dict:
@@ -934,7 +934,9 @@ class ArmCore:
         cur = self.device.current
         return cur.motion.ramp if cur is not None else self.accel_time_joint
 
-    def stop_motion(self, fastest: bool = False) -> None:
+    def stop_motion(self, fastest: bool = False, reason: str = STOPPED) -> None:
+        """Stop at the motion's accel time (or the fastest the settings allow); `reason` is
+        what a wait on a discarded motion is told."""
         cur = self.device.current
         if fastest:
             ramp = (self.min_accel_time_cartesian
@@ -942,4 +944,4 @@ class ArmCore:
                     else self.min_accel_time_joint)
         else:
             ramp = self.current_ramp()
-        self.device.stop(ramp)
+        self.device.stop(ramp, reason)

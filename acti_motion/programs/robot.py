@@ -234,7 +234,7 @@ class RobotHost(Host):
     def stop(self, error) -> None:
         """The program stopped on an exception: the arm decelerates and its queue is discarded."""
         self.state = "stopping"
-        self.arm.stop_motion()
+        self.arm.stop_motion(reason=f"the program's end: {error}")
 
     def wait_at_rest(self) -> None:
         """After a stop: until the arm is at rest, so that a run ends with the robot stopped

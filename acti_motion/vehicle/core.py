@@ -13,7 +13,7 @@ import threading
 import time
 from typing import Any, Callable
 
-from acti_motion.executor import STALE, Device, MotionExecutor
+from acti_motion.executor import STALE, STOPPED, Device, MotionExecutor
 from acti_motion.replies import Refused, Reply, finite_number
 from acti_motion.vehicle.alarms import AlarmCode, Alarms, AlarmType, Kind
 from acti_motion.vehicle.config import VehicleConfig, check_config
@@ -149,7 +149,7 @@ class VehicleCore(Sensing):
                                  f"{self.config.battery_hysteresis:g} V: power stays off")
         if not on_off:
             self.servo = False       # before the stop: a plan that commits after it sees it
-            self._stop()
+            self._stop("power off")
         self.power = bool(on_off)
 
     @command
@@ -166,7 +166,7 @@ class VehicleCore(Sensing):
                                  f"off until {self._remedy(alarm.code)}")
         if not on_off:
             self.servo = False       # before the stop: a plan that commits after it sees it
-            self._stop()
+            self._stop("servo off")
         self.servo = bool(on_off)
 
     def _remedy(self, code: int) -> str:
@@ -628,7 +628,7 @@ class VehicleCore(Sensing):
         """Commit of a take-over when no tracked motion runs: the moves accepted but not
         started (or queued behind a brake) give way; the new one is then submitted."""
         if not device.stopping:
-            device.discard_queue()
+            device.discard_queue("replaced by a newer move before it started")
             self._op_generation = device.generation     # this operation's own discard
 
     def _take_over(self, device: Device, cur: Any, t: float, path: Path, label: str) -> Any:
@@ -639,10 +639,10 @@ class VehicleCore(Sensing):
         if device.t > t:
             return STALE
         self._admit(SERVO_ON, label, device)
-        device.discard_queue()
+        device.discard_queue(f"taken over by {label}")
         self._op_generation = device.generation         # this operation's own discard
         if not (label == cur.label and label in VELOCITY_DRIVEN):
-            device.renumber(cur)
+            device.renumber(cur, f"taken over by {label}")
         cur.motion = cur.motion.handover(t, path, label)
         cur.label = label
         return cur.id
@@ -783,16 +783,18 @@ class VehicleCore(Sensing):
     def _resume_ramp(self) -> float:
         return self._ramp(self.acceleration, up=True)
 
-    def _stop(self) -> None:
+    def _stop(self, reason: str = STOPPED) -> None:
+        """Decelerate at the maximum acceleration and discard everything, `reason` given to
+        the waits on what is discarded."""
         cur = self.device.current
         if cur is not None and isinstance(cur.motion, BrakeMotion):
-            self.device.edit(Device.discard_queue)
+            self.device.edit(lambda device: device.discard_queue(reason))
             return
-        self.device.stop(self._stop_ramp())
+        self.device.stop(self._stop_ramp(), reason)
 
-    def _halt(self) -> None:
+    def _halt(self, reason: str) -> None:
         """Give up the plan at once and brake the wheels at the maximum acceleration."""
         c = self.config
-        self.device.halt(self.odometry.pose)
+        self.device.halt(self.odometry.pose, reason)
         decel = (c.accel_limit_translation / 1000.0, math.radians(c.accel_limit_rotation))
         self.device.submit(lambda start: BrakeMotion(self.odometry, decel), "brake")

@@ -40,7 +40,7 @@ class Sensing:
                 self.locked = True
                 self.alarms.raise_(AlarmCode.CONTACT, "contact sensor: the bumper touched something",
                                    Kind.CONTACT)
-                self._halt()
+                self._halt("a contact (the base is Locked)")
         self._watch_tracking(world.time)
         self._watch_deadman()
 
@@ -103,7 +103,7 @@ class Sensing:
             self.alarms.raise_(AlarmCode.STUCK,
                                f"the base {what} ({1000 * dist:.0f} mm, "
                                f"{math.degrees(angle):.1f}° off): stopped", Kind.STUCK)
-            self._halt()
+            self._halt(f"a blockage: the base {what}")
 
     def _check_battery(self, voltage: float) -> None:
         """Raise the battery alarms whose level is tripped (with hysteresis); the cut-off one
@@ -119,7 +119,7 @@ class Sensing:
                                    "servo off", Kind.CONDITION)
                 if self.servo:
                     self.servo = False
-                    self._stop()
+                    self._stop("the battery cut-off (servo off)")
 
     def _drain_battery(self) -> None:
         if not self.power:
