@@ -6,15 +6,20 @@ FILE is the text form (.sasm, .txt, .strolic) or raw code (anything else); it is
 and sent as code to ~/run_program. Progress lines show the program counter (byte offset, as
 `python -m strolic dis --offsets` numbers the codes), the state and the arm's motion; at the end
 the console lines, what the program sent, the final stack and the exception report if any.
-Ctrl-C cancels the run (the program and the arm stop). Exit status: 0 the program finished,
-1 an exception stopped it, 2 it was canceled or did not load, 3 no node answered (or it went away).
+Ctrl-C cancels the run (the program and the arm stop); Ctrl-C before the program was sent, or
+again while the cancel is under way, ends this command at once (the node still cancels). Exit
+status: 0 the program finished, 1 an exception stopped it, 2 it was canceled, interrupted or did
+not load, 3 no node answered (or it went away).
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
+import signal
 import sys
 import time
 from pathlib import Path
+from typing import Iterator
 
 import rclpy
 from acti_msgs.action import RunProgram
@@ -79,41 +84,59 @@ def run(args: argparse.Namespace) -> int:
     node = rclpy.create_node("run_program")
     client = ActionClient(node, RunProgram, f"{args.node.rstrip('/')}/run_program")
     try:
-        if not client.wait_for_server(timeout_sec=SERVER_TIMEOUT):
-            print(f"no {args.node}/run_program answered in {SERVER_TIMEOUT:g} s", file=sys.stderr)
-            return 3
-        last = [None]
-
-        def show(message) -> None:
-            """A line when the state or the motion changes (every message with --verbose)."""
-            f = message.feedback
-            key = (f.state, f.message, f.motion_id, int(4 * f.progress))
-            if args.verbose or not args.quiet and key != last[0]:
-                print(describe(f), flush=True)
-            last[0] = key
-        goal = RunProgram.Goal(code=list(code), budget=args.budget)
-        sent = client.send_goal_async(goal, feedback_callback=show)
-        rclpy.spin_until_future_complete(node, sent)
-        handle = sent.result()
-        if not handle.accepted:
-            print("the node refused the program (another one is running?)", file=sys.stderr)
-            return 2
-        done = handle.get_result_async()
-        try:
-            if not wait_for(node, client, done):
-                return 3
-        except KeyboardInterrupt:
-            print("canceling ...", file=sys.stderr)
-            rclpy.spin_until_future_complete(node, handle.cancel_goal_async(), timeout_sec=10.0)
-            if not wait_for(node, client, done):
-                return 3
-        result = done.result().result
-        report(result)
-        return {RunProgram.Result.FINISHED: 0, RunProgram.Result.EXCEPTION: 1}.get(result.status, 2)
+        return _send_and_follow(args, code, node, client)
+    except KeyboardInterrupt:       # before the program was sent, or again while canceling
+        print("interrupted", file=sys.stderr)
+        return 2
     finally:
         client.destroy()
         node.destroy_node()
         rclpy.try_shutdown()
+
+
+def _send_and_follow(args: argparse.Namespace, code: bytes, node, client: ActionClient) -> int:
+    """Send the program, show its progress, cancel it on Ctrl-C; the exit status."""
+    if not client.wait_for_server(timeout_sec=SERVER_TIMEOUT):
+        print(f"no {args.node}/run_program answered in {SERVER_TIMEOUT:g} s", file=sys.stderr)
+        return 3
+    last = [None]
+
+    def show(message) -> None:
+        """A line when the state or the motion changes (every message with --verbose)."""
+        f = message.feedback
+        key = (f.state, f.message, f.motion_id, int(4 * f.progress))
+        if args.verbose or not args.quiet and key != last[0]:
+            print(describe(f), flush=True)
+        last[0] = key
+    goal = RunProgram.Goal(code=list(code), budget=args.budget)
+    with _sigint_ignored():     # until accepted: a Ctrl-C then would leave the run uncanceled
+        sent = client.send_goal_async(goal, feedback_callback=show)
+        rclpy.spin_until_future_complete(node, sent)
+    handle = sent.result()
+    if not handle.accepted:
+        print("the node refused the program (another one is running?)", file=sys.stderr)
+        return 2
+    done = handle.get_result_async()
+    try:
+        if not wait_for(node, client, done):
+            return 3
+    except KeyboardInterrupt:
+        print("canceling ...", file=sys.stderr)
+        rclpy.spin_until_future_complete(node, handle.cancel_goal_async(), timeout_sec=10.0)
+        if not wait_for(node, client, done):
+            return 3
+    result = done.result().result
+    report(result)
+    return {RunProgram.Result.FINISHED: 0, RunProgram.Result.EXCEPTION: 1}.get(result.status, 2)
+
+
+@contextlib.contextmanager
+def _sigint_ignored() -> Iterator[None]:
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -173,3 +173,19 @@ def test_command_line_ctrl_c_cancels_the_run(ros, arm_node):
     assert cli.returncode == 2, out
     assert "canceled after" in out and "stopped by the operator" in out
     assert wait_until(lambda: not moving(ros), 5.0)
+
+
+def test_command_line_ctrl_c_while_waiting_for_the_node_is_one_line(ros, arm_node):
+    """Before anything was sent (a wrong --node): a KeyboardInterrupt traceback and exit 130."""
+    cli = subprocess.Popen([sys.executable, "-m", "acti_middle_node.run_program", "--node",
+                            "/nobody", str(EXAMPLES / "robot_palletising.sasm")],
+                           cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                           env=dict(os.environ))
+    try:       # its node is up: it waits for /nobody/run_program
+        assert ros.spin_until(lambda: "run_program" in ros.node.get_node_names(), 30.0)
+        cli.send_signal(signal.SIGINT)
+        out, _ = cli.communicate(timeout=30)
+    finally:
+        if cli.poll() is None:
+            cli.kill()
+    assert cli.returncode == 2 and out.strip() == "interrupted", out
