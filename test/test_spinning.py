@@ -114,6 +114,8 @@ def test_the_nodes_end_cleanly_on_a_signal(ros, tmp_path, module, up, signum):
     ("acti_bringup", "initial_joints_deg:=[0.0,30.0,0.0,-60.0,0.0,.inf,0.0]", "",
      "initial_joints_deg = [0.0, 30.0, 0.0, -60.0, 0.0, inf, 0.0]: it must be finite"),
     ("acti_bringup", "view_host:=192.0.2.1", "", "is not an address of this machine"),
+    # named alone (it listed every view rule with its value: "view_port … (is 8080)")
+    ("acti_bringup", "acti_view:view_rate_hz:=0.0", "", "view_rate_hz out of range"),
     ("acti_bringup", "rate_hz:=250.0", "/robot-1", "Couldn't parse remap rule")])
 def test_a_refused_start_up_setting_is_one_line_and_exit_status_2(tmp_path, module, param,
                                                                   namespace, words):

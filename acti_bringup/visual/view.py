@@ -2,13 +2,13 @@
 ROS-free `acti_view.live.LiveView` to the cores and the world of the hosted simulation."""
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from rclpy.node import Node
 
 from acti_bringup.serving.parameters import declare_config
 from acti_bringup.simulation import Simulation
+from acti_motion.config_fields import RATE_RANGE_HZ, ranged
 from acti_motion.arm.core import ArmCore
 from acti_motion.vehicle.core import VehicleCore
 from acti_sim.world import URDF_PATH
@@ -20,9 +20,12 @@ from acti_view.sample import Reader, WorldSampler
 class ViewConfig:
     view_enabled: bool = True         # serve the live 3D view in a browser
     view_host: str = "127.0.0.1"      # address the view listens on (127.0.0.1: this machine only)
-    view_port: int = 8080             # port of the view; the next free one when in use; 0: any free one
-    view_rate_hz: float = 25.0        # scene updates per second while a page is open [Hz]
-    view_trail_points: int = 2000     # points kept in the control-point trail and the odometry path
+    # port of the view; the next free one when in use; 0: any free one
+    view_port: int = ranged(8080, 0, 65535)
+    # scene updates per second while a page is open [Hz]
+    view_rate_hz: float = ranged(25.0, *RATE_RANGE_HZ)
+    # points kept in the control-point trail and the odometry path
+    view_trail_points: int = ranged(2000, 2, 1_000_000)
 
 
 class ViewNode(Node):
@@ -35,11 +38,6 @@ class ViewNode(Node):
         if not c.view_enabled:
             self.get_logger().info("live view off (view_enabled:=false)")
             return
-        if not 0 <= c.view_port < 65536 or not 0 < c.view_rate_hz < math.inf \
-                or c.view_trail_points < 2:
-            raise ValueError(f"view_port must be 0 … 65535 (is {c.view_port}), view_rate_hz > 0 "
-                             f"and finite (is {c.view_rate_hz}), view_trail_points ≥ 2 "
-                             f"(is {c.view_trail_points})")
         every = max(1, round(simulation.config.rate_hz / c.view_rate_hz))
         reader = Reader(WorldSampler(simulation.executor, every), arm, vehicle)
         self.view = LiveView(reader, {"arm": arm, "base": vehicle}, URDF_PATH, c.view_host,
