@@ -41,6 +41,7 @@ class VM:
         self._compiled_bytes = 0           # bytes of the bodies in _compiled
         self.generation = 0                # bumped whenever waiting processes may proceed
         self.executed = 0                  # instructions of the current run (budget)
+        self.in_slice = 0                  # … and of the slice a host function blocks in
         self.budget: int | None = None
         self.main: Process | None = None   # process 0, the program of the current run
         self.files: dict = {}              # file number → open file (functions/system_files.py)
@@ -295,8 +296,11 @@ class VM:
                         stack.append(instruction[1])
                     elif op == BUILTIN:
                         handler = instruction[1].handler
-                        result = (handler(self, proc) if handler is not None
-                                  else self.host.call(self, proc, instruction[1]))
+                        if handler is not None:
+                            result = handler(self, proc)
+                        else:       # a host function may block (PAUSE): the count so far shows
+                            self.in_slice = count
+                            result = self.host.call(self, proc, instruction[1])
                         if result is WAIT:
                             frame.pc = pc
                             proc.state = State.WAITING
@@ -320,6 +324,7 @@ class VM:
                                proc, frame, instruction) from error
         finally:
             self.executed += count
+            self.in_slice = 0
             proc.last_run = self.executed
 
     def _locate(self, error: StrolicError, proc: Process, frame: Frame,

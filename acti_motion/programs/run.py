@@ -124,7 +124,8 @@ class ProgramRun:
 
     def progress(self) -> Progress:
         vm, host = self.vm, self.host
-        out = Progress(instructions=vm.executed, state=host.state, message=host.message)
+        out = Progress(instructions=vm.executed + vm.in_slice, state=host.state,
+                       message=host.message)
         main = vm.main
         if main is not None:
             frame = main.frame

@@ -148,6 +148,23 @@ def test_pause_holds_the_arm_until_the_operator_resumes(arm, executor):  # noqa:
     assert abs(numbers(result.stack[-1])[0] - 40.0) < 0.05   # and then went on
 
 
+def test_progress_while_paused_counts_the_instructions_run(arm, executor):  # noqa: F811
+    """A PAUSE blocks inside its slice: the count read 0 until the slice ended."""
+    program = ProgramRun(arm, '1 2 3 DROP DROP DROP "hold" PAUSE', step=None)
+    seen = []
+
+    def step():
+        executor.step()
+        if arm.device.paused:
+            seen.append(program.progress())
+            if len(seen) > 50:
+                assert arm.resume().ok
+    program.host.step = step
+    assert program.run().status is Status.FINISHED
+    assert seen and {p.state for p in seen} == {"paused"}
+    assert {p.instructions for p in seen} == {7}                # 1 2 3 DROP×3 "hold": PAUSE runs
+
+
 def arm_rest_after(executor, arm, since):  # noqa: F811
     """Simulated seconds from `since` until the measured joints are still."""
     t0 = executor.world.time
