@@ -105,7 +105,7 @@ def test_snapshot_writes_a_picture_of_the_robot(tmp_path):
 
 
 @pytest.mark.parametrize("args, folder, words", [
-    (["--joints", "500", "0", "0", "0", "0", "0", "0"], "", "initial_joints_deg"),
+    (["--joints", "500", "0", "0", "0", "0", "0", "0"], "", "--joints 500 0 0 0 0 0 0: the joints"),
     # were a ZeroDivisionError, a std::bad_alloc abort and a FileNotFoundError traceback
     (["--size", "0", "0"], "", "--size 0 0: both must be positive"),
     (["--size", "100000", "100000"], "", "at most 2073600 px"),

@@ -17,7 +17,8 @@ SETTLE_STEPS = 240
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m acti_bringup.visual.snapshot",
+                                     description=__doc__.splitlines()[0])
     parser.add_argument("out", help="the PNG to write")
     parser.add_argument("--joints", type=float, nargs=7, metavar="DEG",
                         default=ArmConfig().initial_joints_deg, help="arm joints [degree]")
@@ -32,8 +33,9 @@ def main(argv: list[str] | None = None) -> None:
         executor = MotionExecutor(world, real_time_factor=0.0)
         try:
             ArmCore(executor, ArmConfig(initial_joints_deg=tuple(args.joints)))
-        except ValueError as e:
-            parser.error(str(e))
+        except ValueError as e:     # the core names its parameter: say the option
+            parser.error(f"--joints {' '.join(f'{q:g}' for q in args.joints)}: "
+                         f"{str(e).replace('initial_joints_deg', 'the joints')}")
         for _ in range(SETTLE_STEPS):
             executor.step()
         try:
