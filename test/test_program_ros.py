@@ -127,7 +127,7 @@ def test_a_stop_from_a_service_stops_the_program(ros, programs):
     assert call(ros, "stop", srv.Stop).return_id.id == 0
     status, result = programs.result(handle)
     assert result.status == R.EXCEPTION and result.exception_kind == "other robot error"
-    assert "a stop discarded motion" in result.exception
+    assert "of the program was discarded: stop" in result.exception, result.exception
 
 
 def test_one_program_at_a_time_and_a_program_that_does_not_load(ros, programs):

@@ -299,10 +299,8 @@ class RobotHost(Host):
         if not lost:
             return None
         self.abnormal = STATUS_DISCARDED
-        if not arm.servo:
-            return K.SERVO_ERROR, f"the servo was turned off: motion {lost[0]} of the program " \
-                                  "was discarded"
-        return K.ROBOT_ERROR, f"a stop discarded motion {lost[0]} of the program"
+        why = f"motion {lost[0]} of the program was discarded: {device.discard_reason(lost[0])}"
+        return (K.SERVO_ERROR if not arm.servo else K.ROBOT_ERROR), why
 
     def motion_status(self) -> int:
         """$DONE: 0 over, 1 the robot moves, 2 only the hand moves, 3 both, < 0 abnormal end."""
