@@ -156,6 +156,33 @@ def test_stop_while_another_thread_plans_discards_that_move(arm, executor, trace
     trace.check_rest(rest_at)
 
 
+def test_a_move_waiting_for_another_plan_is_refused_after_servo_off(arm, executor):  # noqa: F811
+    """B passed the servo check, then waited while A planned; servo_off came meanwhile (the arm
+    idle): B was queued after that stop and ran with the servo off."""
+    start = arm.device.hold.joints.copy()
+    entered, out = threading.Event(), {}
+    submit = arm.device.submit
+
+    def submit_entered(*args, **kwargs):
+        entered.set()
+        return submit(*args, **kwargs)
+
+    def servo_off_while_b_waits():
+        arm.device.submit = submit_entered
+        b = threading.Thread(target=lambda: out.setdefault(
+            "b", arm.move_ptp_joint_rel([10.0] + [0.0] * 6)))
+        b.start()
+        assert entered.wait(30.0)
+        assert arm.servo_off().ok
+        out["thread"] = b
+    a = while_planning(arm, servo_off_while_b_waits)
+    out["thread"].join(30.0)
+    assert a.ok and arm.device.was_discarded(a.values["motion_id"])
+    assert out["b"].code == R.NOT_SV_ON_ERR, out["b"]
+    steps(executor, 250)
+    assert not arm.device.busy and np.allclose(arm.device.hold.joints, start)
+
+
 def test_stop_between_accept_and_pick_up_moves_nothing(arm, executor, trace):  # noqa: F811
     start = arm.device.hold.joints.copy()
     assert arm.move_ptp_joint_rel([10.0] * 7).ok and arm.move_ptp_joint_rel([10.0] * 7).ok

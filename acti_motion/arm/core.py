@@ -911,7 +911,11 @@ class ArmCore:
 
     def _submit(self, plan: Callable[[ArmSetpoint], ArmMotion], label: str) -> dict:
         def guarded(start: ArmSetpoint) -> ArmMotion:
-            """A refusal passes; any other failure of planning is this request's NG, said."""
+            """A refusal passes; any other failure of planning is this request's NG, said. The
+            servo and alarms are checked again here, after the device took its generation: a
+            servo_off (or an alarm) that came while this request waited for another's plan
+            stopped an idle arm, and the move would have been queued behind it."""
+            self._check_can_move()
             try:
                 motion = plan(start)
             except Refused:
