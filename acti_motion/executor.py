@@ -223,9 +223,11 @@ class Device:
         self._reason = reason
         self._retire_queue()
 
-    def halt(self, rest: Any, reason: str) -> None:
+    def halt(self, rest: Any, reason: str, then: tuple[Motion, str] | None = None) -> None:
         """Discard the current motion and the queue at once and rest at `rest` (where the device
-        is, as measured): for a device that cannot follow its plan (blocked, a contact)."""
+        is, as measured): for a device that cannot follow its plan (blocked, a contact). `then`
+        (motion, label) is queued at once, as the only motion (a brake): through `submit` it
+        would wait for whoever plans, and the simulation thread that halts must never wait."""
         with self.lock:
             self._reason = reason
             self._discard_pending()
@@ -234,6 +236,11 @@ class Device:
             self._stop_at = None
             self.rate = self._rate_target = 1.0
             self.hold = self.queued_end = rest
+            if then is not None:
+                self.last_id += 1
+                self.revision += 1
+                self.queue.append(QueuedMotion(self.last_id, *then))
+                self.queued_end = self._end_of_queue()
             self.changed.notify_all()
 
     def renumber(self, entry: QueuedMotion, reason: str) -> int:

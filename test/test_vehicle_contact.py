@@ -63,3 +63,39 @@ def test_contact_with_the_sensor_off_is_a_blockage(base, executor, wall):  # noq
     assert base.move_forward(-300.0).ok and state(base) == VehicleState.BUSY   # moving on clears it
     settle(executor, base)
     assert state(base) == VehicleState.READY and base.get_input(1).values["input"] == 0
+
+
+def test_a_contact_while_another_thread_plans_a_move_does_not_deadlock(base, executor):  # noqa: F811
+    """The simulation thread raised the contact under the core's lock and queued its brake
+    through submit, which waited for the planning thread; that plan waited for the core's lock:
+    neither went on, and the base was never stepped again."""
+    import threading
+    ready(base)
+    assert base.set_digital_sensor_lock(True).ok
+    in_plan, sim_has_lock, out = threading.Event(), threading.Event(), {}
+    submit, raise_ = base.device.submit, base.alarms.raise_
+
+    def held_submit(plan, label):            # the service thread's plan waits for the contact
+        def held(start):
+            in_plan.set()
+            assert sim_has_lock.wait(30.0)
+            return plan(start)
+        return submit(held, label)
+
+    def raising(code, *args, **kwargs):      # raised under the core's lock
+        raise_(code, *args, **kwargs)
+        if code == AlarmCode.CONTACT:
+            sim_has_lock.set()
+    base.device.submit, base.alarms.raise_ = held_submit, raising
+    service = threading.Thread(target=lambda: out.setdefault("move", base.move_forward(200.0)),
+                               daemon=True)
+    service.start()
+    assert in_plan.wait(30.0)
+    executor.world.bumper_in_contact = lambda: True
+    simulation = threading.Thread(target=executor.step, daemon=True)
+    simulation.start()
+    simulation.join(10.0)
+    service.join(10.0)
+    assert not simulation.is_alive() and not service.is_alive(), "deadlock"
+    assert not out["move"].ok and "Locked" in out["move"].comment
+    assert state(base) == VehicleState.LOCKED

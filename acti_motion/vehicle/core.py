@@ -795,6 +795,6 @@ class VehicleCore(Sensing):
     def _halt(self, reason: str) -> None:
         """Give up the plan at once and brake the wheels at the maximum acceleration."""
         c = self.config
-        self.device.halt(self.odometry.pose, reason)
         decel = (c.accel_limit_translation / 1000.0, math.radians(c.accel_limit_rotation))
-        self.device.submit(lambda start: BrakeMotion(self.odometry, decel), "brake")
+        self.device.halt(self.odometry.pose, reason,
+                         then=(BrakeMotion(self.odometry, decel), "brake"))
