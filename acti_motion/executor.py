@@ -133,11 +133,13 @@ class Device:
                     self.changed.notify_all()
                     return self.last_id
 
-    def pause(self, ramp: float) -> bool:
+    def pause(self, ramp: float, idle: bool = True) -> bool:
         """Decelerate over `ramp` seconds and hold (also what is queued and not yet started);
-        the queue stays. False when already paused or stopping (a stop clears a pause)."""
+        the queue stays. False when already paused or stopping (a stop clears a pause), and,
+        unless `idle`, when nothing runs or is queued: checked here, under the lock a stop takes
+        (a stop or servo_off between the caller's check and this left an idle arm paused)."""
         with self.lock:
-            if self.paused or self._stop_at is not None:
+            if self.paused or self._stop_at is not None or not (idle or self.busy):
                 return False
             self.paused = True
             self._set_rate(0.0, ramp)

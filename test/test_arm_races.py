@@ -311,3 +311,30 @@ def test_a_motion_that_fails_while_running_is_discarded_and_the_simulation_goes_
     assert arm.move_ptp_joint_rel([-5.0] * 7).ok                          # and moves again
     rest(executor, arm)
     assert arm.device.completed == 1
+
+
+@pytest.mark.parametrize("first", ["servo_off", "stop"])
+def test_a_stop_between_pauses_check_and_its_act_leaves_nothing_paused(arm, executor, first):  # noqa: F811
+    """pause checked (a move queued, servo on), then servo_off or stop discarded the queue, then
+    pause paused the idle arm: later moves were accepted and never ran."""
+    assert arm.move_ptp_joint_rel([10.0] * 7).ok               # queued, not picked up yet
+    checked, go, out = threading.Event(), threading.Event(), {}
+    pause = arm.device.pause
+
+    def held(*args, **kwargs):
+        checked.set()
+        assert go.wait(30.0)
+        return pause(*args, **kwargs)
+    arm.device.pause = held
+    p = threading.Thread(target=lambda: out.setdefault("pause", arm.pause()))
+    p.start()
+    assert checked.wait(30.0)
+    assert getattr(arm, first)().ok
+    go.set()
+    p.join(30.0)
+    assert out["pause"].ok and "ignored" in out["pause"].comment
+    assert not arm.device.paused and not arm.state_word() & 0x10
+    assert arm.servo_on().ok
+    motion = arm.move_ptp_joint_rel([5.0] + [0.0] * 6).values["motion_id"]
+    run_until(executor, lambda: arm.device.is_over(motion), 5.0)
+    assert not arm.device.was_discarded(motion)

@@ -531,8 +531,8 @@ class ArmCore:
             why = "the arm is not moving" if not self.device.busy else "it is stopping"
         if why is not None:
             return _ignored(why)
-        if not self.device.pause(self.current_ramp()):
-            return _ignored("already paused or stopping")
+        if not self.device.pause(self.current_ramp(), idle=False):
+            return _ignored("a stop came first: nothing is left to pause")
         return None
 
     @returns(*CONTROL)
