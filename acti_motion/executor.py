@@ -7,12 +7,13 @@ simulation thread ramps linearly, so every motion decelerates along its own path
 """
 from __future__ import annotations
 
+import contextlib
 import logging
 import threading
 import time
 from collections import deque
 from dataclasses import dataclass
-from typing import Any, Callable, Protocol
+from typing import Any, Callable, Iterator, Protocol
 
 from acti_sim.world import World
 
@@ -244,6 +245,20 @@ class Device:
                 self.queue.append(QueuedMotion(self.last_id, *then))
                 self.queued_end = self._end_of_queue()
             self.changed.notify_all()
+
+    @contextlib.contextmanager
+    def idle_for_settings(self) -> Iterator[bool]:
+        """Planning held off while the caller changes what plans read (the arm's frames); yields
+        whether nothing runs, is queued or is being planned. Never waits: a plan under way (it
+        holds the accept lock) answers False, and one that comes waits the few microseconds
+        the caller takes."""
+        if not self._accept.acquire(blocking=False):
+            yield False
+            return
+        try:
+            yield not self.busy
+        finally:
+            self._accept.release()
 
     def renumber(self, entry: QueuedMotion, reason: str) -> int:
         """(lock held) The running motion `entry`, taken over by a command with another goal,

@@ -338,3 +338,21 @@ def test_a_stop_between_pauses_check_and_its_act_leaves_nothing_paused(arm, exec
     motion = arm.move_ptp_joint_rel([5.0] + [0.0] * 6).values["motion_id"]
     run_until(executor, lambda: arm.device.is_over(motion), 5.0)
     assert not arm.device.was_discarded(motion)
+
+
+def test_offsets_are_refused_while_a_move_is_planned(arm, executor):  # noqa: F811
+    """A move copied the frames when called and planned with them while an offset set
+    meanwhile was answered OK: it ended 20 mm from where the new frame put its target."""
+    before = arm.get_feedback_pos_cartesian().values["pos"][0][3]
+    shifted = [*IDENTITY[:3], 20.0, *IDENTITY[4:]]
+    answers = {}
+
+    def set_offsets():
+        answers["base"] = arm.set_base_offset(shifted)
+        answers["tool"] = arm.set_control_point_offset(shifted)
+    assert while_planning(arm, set_offsets).ok                 # the move: +50 mm in x
+    assert answers["base"].code == R.NG and "planned" in answers["base"].comment
+    assert answers["tool"].code == R.STATUS_ERR and "planned" in answers["tool"].comment
+    run_until(executor, lambda: not arm.device.busy, 10.0)
+    after = arm.get_feedback_pos_cartesian().values["pos"][0][3]
+    assert after - before == pytest.approx(50.0, abs=0.05)

@@ -496,22 +496,25 @@ class ArmCore:
         is queued: their targets were given in the present robot frame, and a queued move ended
         100 mm from where the new frame said it should."""
         base = _offset(offset, BASE_OFFSET_MM, ReturnCode.VALUE_ERR)
-        if self.device.busy:
-            raise Refused(R.NG, "set_base_offset is refused while a motion is running, paused "
-                                "or queued: their targets are in the present robot frame "
-                                "(wait or stop first)")
-        self.frames = Frames(base, self.frames.tool)
+        with self.device.idle_for_settings() as idle:
+            if not idle:
+                raise Refused(R.NG, "set_base_offset is refused while a motion is planned, "
+                                    "running, paused or queued: its target is in the present "
+                                    "robot frame (wait or stop first)")
+            self.frames = Frames(base, self.frames.tool)
 
     @returns(R.STATUS_ERR)
     def set_control_point_offset(self, offset: list[float]) -> None:
         """Refused while anything runs, is paused mid-move or is queued: those targets were
         planned with the present control point (5.4.23: not while moving)."""
-        if self.device.busy:
-            raise Refused(R.STATUS_ERR, "set_control_point_offset is refused while a motion is "
-                                        "running, paused or queued (wait or stop first)")
         self._check_idle("set_control_point_offset")
         tool = _offset(offset, CONTROL_POINT_OFFSET_MM, ReturnCode.NG)
-        self.frames = Frames(self.frames.base, tool)
+        with self.device.idle_for_settings() as idle:
+            if not idle:
+                raise Refused(R.STATUS_ERR, "set_control_point_offset is refused while a motion "
+                                            "is planned, running, paused or queued (wait or stop "
+                                            "first)")
+            self.frames = Frames(self.frames.base, tool)
 
     @returns(*SETTER)
     def set_home(self, joint_point: list[float]) -> None:
@@ -799,9 +802,9 @@ class ArmCore:
         ratio = self.speed_joint if speed_ratio is None else speed_ratio
         speed = np.radians(self.max_speed_joint) * ratio / 100.0
         ramp = self.accel_time_joint if ramp is None else ramp
-        frames = self.frames
 
         def plan(start: ArmSetpoint) -> ArmMotion:
+            frames = self.frames          # read while planning: the offsets wait for it
             goal = goal_of(start)
             self._check_joint_target(np.degrees(goal), label)
             path = LinearJointPath(start.joints, goal)
@@ -836,10 +839,11 @@ class ArmCore:
                              psi: float | None = None, turn: float = 0.0) -> dict:
         """A PTP move to the control-point pose target_of(start pose), with the elbow at arm
         angle `psi`, or (Rel) turned by `turn` (rad) from where it starts."""
-        frames, kin = self.frames, self.kin
+        kin = self.kin
         lo, hi = np.radians(self.soft_limit_joint[:, 0]), np.radians(self.soft_limit_joint[:, 1])
 
         def goal_of(start: ArmSetpoint) -> np.ndarray:
+            frames = self.frames          # read while planning: the offsets wait for it
             target = target_of(frames.tool_of(kin.flange(start.joints)))
             self._check_cartesian_positions(target[None, :3, 3] * 1000.0, label)
             self._check_reach(target[None, :3, 3], frames, label)
@@ -863,7 +867,6 @@ class ArmCore:
         """A CP move along path_of(start pose); the elbow ends at arm angle `psi`, or (Rel) is
         turned by `turn` (rad) from where it starts. Speed ratio and accel time: the port's
         settings unless given."""
-        frames = self.frames
         v, w = self.max_speed_cartesian
         ratio = (self.speed_cartesian if speed_ratio is None else speed_ratio) / 100.0
         ramp = self.accel_time_cartesian if ramp is None else ramp
@@ -873,6 +876,7 @@ class ArmCore:
             joint_accel=np.radians(self.max_speed_joint) / self.min_accel_time_joint)
 
         def plan(start: ArmSetpoint) -> ArmMotion:
+            frames = self.frames          # read while planning: the offsets wait for it
             try:
                 path = path_of(frames.tool_of(self.kin.flange(start.joints)))
                 self.planner.check_length(path, frames)

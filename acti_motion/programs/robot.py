@@ -451,12 +451,13 @@ class RobotHost(Host):
     def _ptp_to(self, target: Target, label: str) -> None:
         """Joint interpolation to a hand pose, in the pose's configuration and elbow angle."""
         arm, kin = self.arm, self.arm.kin
-        flange = arm.frames.flange_of(target.pose @ inverse(self.tool))
+        hand = target.pose @ inverse(self.tool)
         psi = math.radians(target.elbow)
         lower, upper = np.radians(arm.soft_limit_joint[:, 0]), np.radians(arm.soft_limit_joint[:, 1])
 
         def goal_of(start: ArmSetpoint) -> np.ndarray:
             reference = configured(start.joints, target.configuration)
+            flange = arm.frames.flange_of(hand)     # the frames in force while planning
             try:
                 q = kin.solve(flange, reference, psi=psi, lower=lower, upper=upper)
             except Unreachable as e:
