@@ -40,6 +40,34 @@ def test_a_paused_jog_resumed_after_its_timeout_does_not_drive_again(base, execu
     assert math.dist(position(base)[:2], held[:2]) < 2.0        # not another 100 mm
 
 
+def test_a_renewal_between_the_deadmans_check_and_its_brake_drives_on(base, executor):  # noqa: F811
+    """The deadman decided on a passed deadline, a renewal then came and was answered OK, and
+    the deadman braked the renewed jog anyway."""
+    ready(base)
+    assert base.set_jog_timeout(30000).ok
+    assert base.move_jog(300.0, 0.0, 0.0).ok
+    steps(executor, 0.3)
+    base._drive_deadline = time.monotonic() - 0.001          # a late client: the timeout passed
+    decided, go = threading.Event(), threading.Event()
+    edit_planned, simulation = base.device.edit_planned, threading.current_thread()
+
+    def held(*args, **kwargs):
+        if threading.current_thread() is simulation:
+            decided.set()
+            assert go.wait(30.0)
+        return edit_planned(*args, **kwargs)
+    base.device.edit_planned = held
+    simulation = threading.Thread(target=executor.step, daemon=True)
+    simulation.start()
+    assert decided.wait(30.0)
+    assert base.move_jog(300.0, 0.0, 0.0).ok                  # the renewal
+    go.set()
+    simulation.join(30.0)
+    base.device.edit_planned = edit_planned
+    steps(executor, 1.0)
+    assert base.odometry.v == pytest.approx(0.3, abs=0.01)   # it drives on
+
+
 def test_the_deadman_counts_wall_time_since_the_last_call(base, executor, trace):  # noqa: F811
     """A simulation slower than the wall clock (here: not stepped at all) does not extend a jog:
     once the timeout has passed in wall time, the next control period brakes it."""

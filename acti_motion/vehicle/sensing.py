@@ -69,6 +69,8 @@ class Sensing:
                                                               (0.0, 0.0), 0.0, accel)
 
             def commit(device: Device) -> None:
+                if time.monotonic() < self._drive_deadline:
+                    return          # renewed meanwhile (its commit holds this lock too)
                 cur.motion.splice(t, path)
                 self._deadman_fired = cur.id
             return commit
