@@ -13,7 +13,7 @@ import threading
 import time
 from collections import deque
 from dataclasses import dataclass
-from typing import Any, Callable, Iterator, Protocol
+from typing import Any, Callable, Iterator, Protocol, Sequence
 
 from acti_sim.world import World
 
@@ -101,38 +101,51 @@ class Device:
 
     def submit(self, plan: Callable[[Any], Motion], label: str) -> int | None:
         """Plan a motion from the end of the last queued one and append it; its id, or None when
-        the queue is full. Planning runs on the caller's thread, never under the lock that pause,
-        stop and the simulation take. Exceptions of `plan` (a refusal) pass through and queue
-        nothing.
+        the queue is full (`submit_all` of one)."""
+        ids = self.submit_all([(plan, label)])
+        return None if ids is None else ids[0]
+
+    def submit_all(self, plans: Sequence[tuple[Callable[[Any], Motion], str]]) -> list[int] | None:
+        """Plan motions one after the other, each from the end of the one before (the first from
+        the end of the last queued), and append them together: their ids, or None when the queue
+        has no room for all of them (then nothing is queued). Planning runs on the caller's
+        thread, never under the lock that pause, stop and the simulation take. Exceptions of a
+        plan (a refusal) pass through and queue nothing: a sequence goes in whole or not at all.
 
         A stop discards every command accumulated until the device is at rest (ACT 5.4.19;
-        the vehicle's 停止後は全ての動作指令を廃棄): a motion that arrives while a stop decelerates,
-        or whose planning a stop (or halt) overtook, is accepted (it gets an id) and discarded
+        the vehicle's 停止後は全ての動作指令を廃棄): motions that arrive while a stop decelerates,
+        or whose planning a stop (or halt) overtook, are accepted (they get ids) and discarded
         when the device comes to rest, or at once when it already rests; `was_discarded(id)`
-        says so, and nothing of it runs.
+        says so, and nothing of them runs.
         """
         with self._accept:
             while True:
                 with self.lock:
-                    if len(self.queue) >= self.capacity:
+                    if len(self.queue) + len(plans) > self.capacity:
                         return None
                     generation, start = self.generation, self.queued_end
-                motion = plan(start)
+                motions = []
+                for plan, _ in plans:
+                    motions.append(plan(start))
+                    start = motions[-1].at(motions[-1].duration)
                 with self.lock:
-                    if len(self.queue) >= self.capacity:
+                    if len(self.queue) + len(plans) > self.capacity:
                         return None
                     if generation != self.generation:
                         if self.current is None and not self.queue:
-                            return self._accept_discarded()
+                            return [self._accept_discarded() for _ in plans]
                         if self._stop_at is None:
                             continue        # a halt's own motion runs: plan again from its end
-                    self.last_id += 1
+                    ids = []
+                    for motion, (_, label) in zip(motions, plans):
+                        self.last_id += 1
+                        self.queue.append(QueuedMotion(self.last_id, motion, label))
+                        ids.append(self.last_id)
                     self.revision += 1
-                    self.queue.append(QueuedMotion(self.last_id, motion, label))
                     if self._stop_at is None:
                         self.queued_end = self._end_of_queue()
                     self.changed.notify_all()
-                    return self.last_id
+                    return ids
 
     def pause(self, ramp: float, idle: bool = True) -> bool:
         """Decelerate over `ramp` seconds and hold (also what is queued and not yet started);

@@ -53,3 +53,25 @@ def test_halt_discards_the_current_and_queued_motions_at_once():
     assert not d.busy and d.retired_id == 3 and d.discarded == 3
     assert d.hold == d.queued_end == 0.42 and d.generation == generation + 1
     assert d.submit(lambda s: Ramp1D(s, 1.0, 1.0), "d") == 4 and d.queued_end == 1.42
+
+
+def test_submit_all_queues_a_sequence_whole_or_not_at_all():
+    d = Device("toy", 4, 0.0)
+    d.submit(lambda s: Ramp1D(s, 1.0, 1.0), "a")
+    starts = []
+
+    def ramp(s):
+        starts.append(s)
+        return Ramp1D(s, 1.0, 1.0)
+    assert d.submit_all([(ramp, "b"), (ramp, "c")]) == [2, 3]
+    assert starts == [1.0, 2.0] and d.queued_end == 3.0           # each from the one before
+    assert d.submit_all([(ramp, "d"), (ramp, "e")]) is None        # room for one only
+    assert d.queue_length == 3 and d.last_id == 3
+
+    def refused(s):
+        raise ValueError("no")
+    try:
+        d.submit_all([(ramp, "d"), (refused, "e")])
+    except ValueError:
+        pass
+    assert d.queue_length == 3 and d.last_id == 3 and d.queued_end == 3.0

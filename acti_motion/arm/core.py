@@ -15,10 +15,11 @@ from __future__ import annotations
 
 import math
 import threading
+from contextlib import contextmanager
 from dataclasses import dataclass
 from enum import IntEnum
 from functools import lru_cache
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 import numpy as np
 
@@ -216,6 +217,7 @@ class ArmCore:
         self.device = executor.add_device("arm", c.queue_size,
                                           ArmSetpoint(q0.copy(), self._finger))
         self._inside: np.ndarray | None = None
+        self._batch = threading.local()               # the moves an `all_or_nothing` collects
         self._cartesian_memo: tuple | None = None     # (joints sample, frames, its pose)
         executor.after_step(self._sample)
 
@@ -914,6 +916,42 @@ class ArmCore:
         return self._submit(plan, label)
 
     def _submit(self, plan: Callable[[ArmSetpoint], ArmMotion], label: str) -> dict:
+        """Queue one planned move; inside `all_or_nothing` (on this thread), collect it."""
+        guarded = self._guarded(plan, label)
+        collected = getattr(self._batch, "plans", None)
+        if collected is not None:
+            collected.append((guarded, label))
+            return {"motion_id": 0}
+        motion_id = self.device.submit(guarded, label)
+        if motion_id is None:
+            raise self._full()
+        return {"motion_id": motion_id}
+
+    @contextmanager
+    def all_or_nothing(self) -> Iterator[list[int]]:
+        """The moves queued inside the block (on this thread) go in together when it ends, each
+        planned from the end of the one before, or none of them: a refusal of any, or a queue
+        without room for all (FULL_MOTION_QUEUE_ERR), queues nothing. The list yielded gets
+        their ids, in order (a program's pose sequence is one command)."""
+        plans: list = []
+        self._batch.plans = plans
+        ids: list[int] = []
+        try:
+            yield ids
+        finally:
+            self._batch.plans = None
+        if plans:
+            got = self.device.submit_all(plans)
+            if got is None:
+                raise self._full()
+            ids.extend(got)
+
+    def _full(self) -> Refused:
+        return Refused(R.FULL_MOTION_QUEUE_ERR,
+                       f"the motion queue is full ({self.device.capacity} motions): wait or stop")
+
+    def _guarded(self, plan: Callable[[ArmSetpoint], ArmMotion],
+                 label: str) -> Callable[[ArmSetpoint], ArmMotion]:
         def guarded(start: ArmSetpoint) -> ArmMotion:
             """A refusal passes; any other failure of planning is this request's NG, said. The
             servo and alarms are checked again here, after the device took its generation: a
@@ -932,11 +970,7 @@ class ArmCore:
             if not math.isfinite(motion.duration):
                 raise value_error(f"{label}: the move would take forever at these settings")
             return motion
-        motion_id = self.device.submit(guarded, label)
-        if motion_id is None:
-            raise Refused(R.FULL_MOTION_QUEUE_ERR,
-                          f"the motion queue is full ({self.device.capacity} motions): wait or stop")
-        return {"motion_id": motion_id}
+        return guarded
 
     def current_ramp(self) -> float:
         cur = self.device.current

@@ -46,7 +46,6 @@ FLAG_RANGE = 2          # outside the motion range: soft limits, unreachable, si
 FLAG_CONFIGURATION = 3  # a Cartesian move to a pose of another configuration than the arm's
 FLAG_NOT_READY = 4      # servo off, an alarm active, or the speed is 0
 FLAG_HAND = 5           # the hand is not defined, or too many hands
-FLAG_QUEUE = 6          # the motion queue filled up meanwhile (service motions)
 # $WAIT / $DONE on an abnormal end (the same event also stops the program, see `check`)
 STATUS_DISCARDED = -1
 STATUS_ALARM = -2
@@ -84,8 +83,7 @@ class Flag(Exception):
 
 
 def refused_flag(refused: Refused) -> Flag:
-    code = {ReturnCode.VALUE_ERR: FLAG_RANGE, ReturnCode.FULL_MOTION_QUEUE_ERR: FLAG_QUEUE
-            }.get(refused.code, FLAG_NOT_READY)
+    code = FLAG_RANGE if refused.code == ReturnCode.VALUE_ERR else FLAG_NOT_READY
     return Flag(code, refused.comment)
 
 
@@ -431,11 +429,27 @@ class RobotHost(Host):
                                      f"({device.capacity} motions)")
         return device.capacity - device.queue_length >= count
 
-    def _submit(self, queue: Callable[[], dict]) -> None:
+    @staticmethod
+    def _submit(queue: Callable[[], dict]) -> None:
         try:
-            self._issued(queue()["motion_id"])
+            queue()
         except Refused as r:
             raise refused_flag(r) from None
+
+    def _queue_together(self, command: Callable[[], None]) -> bool:
+        """Queue the motions `command` gives as one (a pose sequence, a grasp): all of them or,
+        on a refusal of any, none. False when another client took the room `_room` saw (the
+        program waits again; nothing was queued)."""
+        try:
+            with self.arm.all_or_nothing() as ids:
+                command()
+        except Refused as r:
+            if r.code == ReturnCode.FULL_MOTION_QUEUE_ERR:
+                return False
+            raise refused_flag(r) from None
+        for motion_id in ids:
+            self._issued(motion_id)
+        return True
 
     def _joint_move(self, goal_of: Callable[[ArmSetpoint], np.ndarray], label: str) -> None:
         self._submit(lambda: self.arm.queue_joint_move(goal_of, label, self.jspeed,
@@ -492,17 +506,14 @@ class RobotHost(Host):
         args = [proc.peek(i) for i in reversed(range(nargs))]
         try:
             self._ready(ratio, setting)
-            if not self._room(count(args)):
+            if not self._room(count(args)) or not self._queue_together(lambda: run(args)):
                 return vm.timed_wait(proc, math.inf, POLL)
         except Flag as flag:
             del proc.stack[len(proc.stack) - nargs:]
+            proc.timed = None
             return self._flag(proc, name, flag)
         del proc.stack[len(proc.stack) - nargs:]
         proc.timed = None
-        try:
-            run(args)
-        except Flag as flag:
-            return self._flag(proc, name, flag)
         self._flag(proc, name, None)
 
     # === ED00–ED05: speeds and accelerations =====================================================
@@ -597,7 +608,10 @@ class RobotHost(Host):
             try:
                 self._ready(self.jspeed, "JSPEED")
                 goal = np.radians(self.arm.home)
-                self._joint_move(lambda start: goal, "CALIB")
+                if not self._queue_together(lambda: self._joint_move(lambda start: goal,
+                                                                      "CALIB")):
+                    proc.wake_at = self.now() + POLL      # another client took the room
+                    return WAIT
             except Flag as flag:
                 raise fail(K.ROBOT_ERROR, f"calibration move refused: {flag.reason}") from None
             motion_id = self._waits[key] = self.last_motion
@@ -796,15 +810,15 @@ class RobotHost(Host):
         return hand
 
     def _hand_motion(self, vm, proc, name: str, opening: Callable[[Hand], float]):
-        if not self._room(1):
-            return self._vm_wait(vm, proc, math.inf)
-        proc.timed = None
         try:
             self._ready(1.0, "")
-            self._gripper(opening(self._hand()), name)
+            if not self._room(1) or not self._queue_together(
+                    lambda: self._gripper(opening(self._hand()), name)):
+                return self._vm_wait(vm, proc, math.inf)
         except Flag as flag:
             kind = K.SERVO_ERROR if not self.arm.servo else K.ROBOT_ERROR
             raise fail(kind, f"{name}: {flag.reason}") from None
+        proc.timed = None
         return None
 
     def handopen(self, vm, proc):

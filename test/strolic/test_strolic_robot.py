@@ -304,3 +304,30 @@ def test_speed_and_acceleration_settings_time_the_moves(arm, executor, settings,
     assert result.status is Status.FINISHED, result.report
     seconds = max(move[1] / ratio, ramp) + ramp
     assert int(result.stack[-1].split(":")[-1]) / 1000.0 == pytest.approx(seconds, abs=0.02)
+
+
+def test_a_pose_sequence_with_a_refused_pose_queues_none_of_it(arm, executor):  # noqa: F811
+    """The sequence is one command: its last pose out of reach leaves the arm where it was."""
+    far = "HERE Vec(0 150 0) DEV HERE Vec(0 0 -50) DEV HERE Vec(0 0 2000) DEV 3 #Pm(120) CONSA"
+    for move in ("AJMOVE", "ALMOVE"):
+        result = run(arm, executor, f"JHERE {far} {move} -1 $WAIT DROP JHERE")
+        assert result.status is Status.FINISHED and result.stack[1] == "I2:2", result.console
+        assert arm.device.last_id == 0
+        assert np.allclose(numbers(result.stack[0]), numbers(result.stack[2]), atol=1e-3)
+
+
+def test_a_program_waits_when_another_client_took_the_room_it_saw(arm, executor):  # noqa: F811
+    """Between the program's look at the queue and its queueing, another client filled it: the
+    program waits for room (nothing of its sequence queued meanwhile), then queues all of it."""
+    queue_together, filled = arm.all_or_nothing, []
+
+    def racing():
+        if not filled:
+            filled.extend(arm.move_ptp_joint_rel([0.0] * 6 + [0.1]) for _ in range(7))
+        return queue_together()
+    arm.all_or_nothing = racing
+    assert arm.set_speed_joint(50).ok
+    result = run(arm, executor, f"{SQUARE} AJMOVE -1 $WAIT HERE")
+    assert all(r.ok for r in filled), filled
+    assert result.status is Status.FINISHED and result.stack[0] == "I2:0", result.console
+    assert arm.device.last_id == 7 + 3 and arm.device.completed == 10
