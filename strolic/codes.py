@@ -155,7 +155,8 @@ def round_half_away(value: float) -> int:
     """Annex 1 §6 rounding of a real where an integer is meant: half away from zero."""
     if math.isnan(value) or math.isinf(value):
         raise fail(K.UNDEFINED_DATA, "cannot round a non-number")
-    return int(math.copysign(math.floor(abs(value) + 0.5), value))
+    whole = math.floor(abs(value))
+    return int(math.copysign(whole + (abs(value) - whole >= 0.5), value))
 
 
 TRUE, FALSE = Num(I2, 1), Num(I2, 0)

@@ -243,7 +243,7 @@ def _c_argument(conversion: bytes, value: Scalar):
         return value.data
     if not isinstance(value, Num):
         raise conversion_error(f"%{conversion.decode()} needs a number, not a string")
-    return float(decimal_of(value))
+    return float(value.value)       # C promotes a float to double: an R4's exact value
 
 
 def c_encode(template: bytes, values: list[Scalar]) -> bytes:
@@ -290,6 +290,8 @@ def c_encode(template: bytes, values: list[Scalar]) -> bytes:
                 digits = b"0" + digits
                 text = digits.ljust(len(text)) if b"-" in flags else digits.rjust(len(text))
             out += text
+        elif conversion in b"xX" and b"#" in flags and argument == 0:   # C: 0, not 0x0
+            out += spec.replace(b"#", b"") % argument
         else:
             out += spec % argument
         check_datum_size(len(out))
@@ -312,12 +314,22 @@ WHITE = b" \t\n\r\f\v"
 
 
 def _scan_set(conversion: bytes) -> bytes:
-    """``[abc]``, ``[^abc]``, ``[]a]`` as a regular expression of one or more such bytes."""
+    """``[abc]``, ``[^abc]``, ``[]a]``, ``[a-z]`` as a regular expression of one or more such
+    bytes; an empty set or a range that runs backwards is a conversion error."""
     body = conversion[1:-1]
     negate = body.startswith(b"^")
     body = body[1:] if negate else body
-    escaped = b"".join(re.escape(bytes([b])) if b != ord("-") or i in (0, len(body) - 1)
-                       else b"-" for i, b in enumerate(body))
+    if not body:
+        raise conversion_error(f"%{conversion.decode(errors='replace')}: an empty scan set")
+    escaped = b""
+    for i, b in enumerate(body):
+        if b == ord("-") and 0 < i < len(body) - 1:
+            if body[i - 1] > body[i + 1]:
+                raise conversion_error(f"%{conversion.decode(errors='replace')}: the range "
+                                       f"{chr(body[i - 1])}-{chr(body[i + 1])} runs backwards")
+            escaped += b"-"
+        else:
+            escaped += re.escape(bytes([b]))
     return b"[" + (b"^" if negate else b"") + escaped + b"]+"
 
 
@@ -389,7 +401,11 @@ def c_decode(template: bytes, data: bytes) -> tuple[list[Scalar], int]:
 
 def _scanned(conversion: bytes, text: bytes) -> Scalar:
     if conversion in BASES:
-        number = int(text, BASES[conversion])
+        base = BASES[conversion]
+        if base == 0:           # %i as C reads it: 0x… hexadecimal, 0… octal, else decimal
+            digits = text.lstrip(b"+-")
+            base = (16 if digits[:2] in (b"0x", b"0X") else 8 if digits[:1] == b"0" else 10)
+        number = int(text, base)
         try:
             return make_number(I4, number)
         except StrolicError:

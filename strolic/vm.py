@@ -6,6 +6,8 @@ when something changed.
 """
 from __future__ import annotations
 
+import numpy as np
+
 from . import opcodes
 from .codec import CodeKind, decode, decode_function
 from .codes import DATA_TYPES, Function, Num, UserCode, is_user_code, user_code_of, user_key
@@ -188,24 +190,27 @@ class VM:
         self.budget = budget
         self.executed = 0
         self.made = 0
-        try:
-            while main.state is not State.DONE:
-                self.interrupts.poll(self)
-                try:
-                    self.host.check(self)
-                except StrolicError as error:
-                    raise self._at_main(error)
-                proc = self._pick()
-                if proc is None:
-                    self._idle()
-                    continue
-                self._execute(proc, SLICE)
-            self.close_files(report=True)
-        except StrolicError as error:
-            self.host.stop(error)
-            raise
-        finally:
-            self.close_files()
+        # numbers that overflow are the program's exceptions (checked as results are made), not
+        # numpy's warnings on the process's stderr
+        with np.errstate(over="ignore", invalid="ignore"):
+            try:
+                while main.state is not State.DONE:
+                    self.interrupts.poll(self)
+                    try:
+                        self.host.check(self)
+                    except StrolicError as error:
+                        raise self._at_main(error)
+                    proc = self._pick()
+                    if proc is None:
+                        self._idle()
+                        continue
+                    self._execute(proc, SLICE)
+                self.close_files(report=True)
+            except StrolicError as error:
+                self.host.stop(error)
+                raise
+            finally:
+                self.close_files()
         return main
 
     def _eligible(self, proc: Process, now: float | None) -> bool:
@@ -318,8 +323,7 @@ class VM:
                     codes = frame.codes
         except StrolicError as error:
             raise self._locate(error, proc, frame, instruction)
-        except (ArithmeticError, ValueError, TypeError, IndexError, KeyError,
-                RecursionError, MemoryError) as error:
+        except Exception as error:      # a fault of the VM itself: the program's exception
             raise self._locate(fail(K.COMPUTER_ERROR, f"{type(error).__name__}: {error}"),
                                proc, frame, instruction) from error
         finally:

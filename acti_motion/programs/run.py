@@ -82,8 +82,13 @@ class ProgramRun:
         vm, host = self.vm, self.host
         start = host.now()
         try:
-            vm.run(self.codes, budget=self.budget)
-            host.wait_motions(vm)
+            try:
+                vm.run(self.codes, budget=self.budget)
+                host.wait_motions(vm)
+            except StrolicError:
+                raise
+            except Exception as e:      # a fault outside the VM's own: it stops the arm too
+                raise StrolicError(K.CONTROLLER_ERROR, f"{type(e).__name__}: {e}") from e
             status, error = Status.FINISHED, None
         except StrolicError as e:
             if host.state != "stopping":

@@ -331,3 +331,20 @@ def test_a_program_waits_when_another_client_took_the_room_it_saw(arm, executor)
     assert all(r.ok for r in filled), filled
     assert result.status is Status.FINISHED and result.stack[0] == "I2:0", result.console
     assert arm.device.last_id == 7 + 3 and arm.device.completed == 10
+
+
+def test_a_fault_outside_the_vm_stops_the_program_and_the_arm(arm, executor):  # noqa: F811
+    """Any failure, not only the program's exceptions, ends the run as an exception and stops
+    the arm (it used to escape the run, which stayed "running" while the arm moved on)."""
+    run_ = ProgramRun(arm, "Ar[R8 60 0 0 0 0 0 0] IDRIVE DROP -1 $WAIT", step=executor.step)
+    check, t0 = run_.host.check, executor.world.time
+
+    def faulty(vm):
+        if executor.world.time - t0 > 0.3:
+            raise RuntimeError("a bug")
+        check(vm)
+    run_.host.check = faulty
+    result = run_.run()
+    assert result.status is Status.EXCEPTION and result.error.kind is K.CONTROLLER_ERROR
+    assert "RuntimeError: a bug" in result.report and run_.host.state == "exception"
+    assert not arm.device.busy and abs(np.degrees(arm.feedback_joints[0]) - WORK[0] - 60) > 10
