@@ -150,6 +150,18 @@ def test_set_velocity_refuses_bad_values(base, pair):
     assert not r.ok and r.comment and base.velocity == (300.0, 45.0)
 
 
+@pytest.mark.parametrize("call, shown", [
+    (lambda b: b.set_velocity((1000.0001, 90.0)), "1000.0001 mm/s"),
+    (lambda b: b.move_turn(3600.0001), "3600.0001 degree"),
+    (lambda b: b.move_linear_abs((100000.1, 0.0, 0.0)), "(100000.1, 0) mm"),
+    (lambda b: b.move_circular_rel((0.0, 100000.1), 90.0), "100000.1 mm")])
+def test_a_refusal_shows_the_value_that_was_refused(base, call, shown):
+    """Just past a limit, the value as sent: rounded, it read as allowed (1000 … 1000 mm/s)."""
+    ready(base)
+    r = call(base)
+    assert not r.ok and shown in r.comment, r.comment
+
+
 @pytest.mark.parametrize("pair", [(NAN, 10.0), (10.0, INF), (0.0, 10.0), (-5.0, 10.0),
                                   (1000.1, 10.0), (10.0, 180.5)])
 def test_set_acceleration_refuses_bad_values(base, pair):

@@ -131,9 +131,11 @@ class VehicleNode(Node):
         x, th, clamped = self.core.clamp_velocity(1000.0 * msg.linear.x, math.degrees(msg.angular.z))
         if (clamped or msg.linear.y != 0.0) and not self._cmd_vel_clamped:
             self._cmd_vel_clamped = True
+            limits = self.core.config
             self.get_logger().info(
-                f"cmd_vel is clamped to the unit's limits ({x:g} mm/s, {th:g} degree/s) and "
-                "linear.y is ignored (differential drive); this is logged once")
+                f"cmd_vel is clamped to the unit's limits (±{limits.velocity_limit_translation:g} "
+                f"mm/s, ±{limits.velocity_limit_rotation:g} degree/s) and linear.y is ignored "
+                "(differential drive); this is logged once")
         reply = self.core.move_jog(x_vel=x, y_vel=0.0, theta_vel=th)
         if not reply.ok:
             self.get_logger().warn(f"cmd_vel refused: {reply.comment}", throttle_duration_sec=2.0)

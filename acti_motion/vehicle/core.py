@@ -384,11 +384,11 @@ class VehicleCore(Sensing):
         angle = math.radians(finite_number(theta, "theta"))
         if cx != 0.0:
             raise VehicleRefused(AlarmCode.NOT_HOLONOMIC,
-                                 f"center_point.x is {cx:g} mm: a differential drive turns only "
+                                 f"center_point.x is {cx:.10g} mm: a differential drive turns only "
                                  "about a point on its wheel axle (x = 0)")
         self._check_rotation(angle, "theta")
         if abs(cy) > self.config.work_area:
-            raise invalid(f"center_point.y is {cy:g} mm: the centre must lie within the work area "
+            raise invalid(f"center_point.y is {cy:.10g} mm: the centre must lie within the work area "
                           f"(±{self.config.work_area:g} mm)")
         self._require(IDLE, "move_circular_rel")
         limits = self._limits()
@@ -491,11 +491,11 @@ class VehicleCore(Sensing):
                                                             ("x_vel", "y_vel", "theta_vel")))
         if vy != 0.0:
             raise VehicleRefused(AlarmCode.NOT_HOLONOMIC,
-                                 f"y_vel is {vy:g} mm/s: a differential drive cannot move sideways")
+                                 f"y_vel is {vy:.10g} mm/s: a differential drive cannot move sideways")
         for value, limit, name, unit in ((vx, c.velocity_limit_translation, "x_vel", "mm/s"),
                                          (vth, c.velocity_limit_rotation, "theta_vel", "degree/s")):
             if abs(value) > limit:
-                raise invalid(f"{name} is {value:g} {unit}: the unit's limit is {limit:g} {unit}")
+                raise invalid(f"{name} is {value:.10g} {unit}: the unit's limit is {limit:g} {unit}")
         self._require(SERVO_ON, "move_jog")
         (at, ar) = self.acceleration
         return self._drive((vx / 1000.0, math.radians(vth)), self.jog_timeout / 1000.0,
@@ -586,14 +586,14 @@ class VehicleCore(Sensing):
         """Refuse a target outside the work area (a plan there could not be made quickly)."""
         area = self.config.work_area
         if not (abs(goal.x) <= area / 1000.0 and abs(goal.y) <= area / 1000.0):
-            raise invalid(f"{what} ({1000.0 * goal.x:.6g}, {1000.0 * goal.y:.6g}) mm is outside "
+            raise invalid(f"{what} ({1000.0 * goal.x:.10g}, {1000.0 * goal.y:.10g}) mm is outside "
                           f"the work area (±{area:g} mm in x and y)")
         return goal
 
     def _check_rotation(self, angle: float, what: str) -> None:
         limit = self.config.turn_limit
         if not abs(math.degrees(angle)) <= limit:
-            raise invalid(f"{what} is {math.degrees(angle):.6g} degree: at most ±{limit:g} degree")
+            raise invalid(f"{what} is {math.degrees(angle):.10g} degree: at most ±{limit:g} degree")
 
     def _limits(self, velocity: tuple[float, float] | None = None,
                 acceleration: tuple[float, float] | None = None) -> tuple[float, float, float, float]:

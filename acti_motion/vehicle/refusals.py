@@ -81,7 +81,7 @@ def bounded_pair(values: Any, lower: tuple[float, float], limits: tuple[float, f
     for value, low, limit, part, u in zip(values, lower, limits, ("translation", "rotation"), unit):
         v = finite_number(value, f"{name}.{part}")
         if not low <= v <= limit:
-            raise invalid(f"{name}.{part} is {v:g} {u}: it must be within {low:g} … {limit:g} {u}")
+            raise invalid(f"{name}.{part} is {v:.10g} {u}: it must be within {low:g} … {limit:g} {u}")
         out.append(v)
     return out[0], out[1]
 
