@@ -42,6 +42,35 @@ class QueuedMotion:
     label: str
 
 
+class DiscardLog:
+    """Which motion ids were discarded, for every id ever given (one bit each), and why, for the
+    last REASONS_KEPT discards (the reasons of older ones are no longer said)."""
+
+    REASONS_KEPT = 256
+    FORGOTTEN = "discarded (why is no longer kept: too many stops since)"
+
+    def __init__(self) -> None:
+        self._bits = bytearray()
+        self._reasons: deque[tuple[int, int, str]] = deque(maxlen=self.REASONS_KEPT)
+
+    def add(self, first: int, last: int, reason: str) -> None:
+        """Ids first … last were discarded, because of `reason`."""
+        need = last // 8 + 1
+        if need > len(self._bits):
+            self._bits.extend(bytes(max(need - len(self._bits), len(self._bits))))
+        for motion_id in range(first, last + 1):
+            self._bits[motion_id >> 3] |= 1 << (motion_id & 7)
+        self._reasons.append((first, last, reason))
+
+    def reason(self, motion_id: int) -> str | None:
+        """Why motion `motion_id` was discarded, None if it was not."""
+        if not (0 <= motion_id >> 3 < len(self._bits)
+                and self._bits[motion_id >> 3] >> (motion_id & 7) & 1):
+            return None
+        return next((why for lo, hi, why in reversed(self._reasons) if lo <= motion_id <= hi),
+                    self.FORGOTTEN)
+
+
 class Device:
     """One bounded FIFO of motions with pause/resume/stop by time scaling.
 
@@ -71,8 +100,7 @@ class Device:
         self.retired_id = 0
         self.completed = 0
         self.discarded = 0
-        # (first id, last id, why) of what stops, halts and take-overs discarded
-        self._discarded_ids: deque[tuple[int, int, str]] = deque(maxlen=256)
+        self._discards = DiscardLog()     # what stops, halts and take-overs discarded
         self._reason = STOPPED      # why the present stop discards (a motion arriving meanwhile)
         self._retire_listeners: list[Callable[[], None]] = []
 
@@ -278,7 +306,7 @@ class Device:
         goes on as that command's motion: its old id retires as discarded (it never reached its
         end, so a wait on it says not completed) and it runs on under a new id, returned."""
         self.discarded += 1
-        self._discarded_ids.append((entry.id, entry.id, reason))
+        self._discards.add(entry.id, entry.id, reason)
         self.retired_id = max(self.retired_id, entry.id)
         self.last_id += 1
         entry.id = self.last_id
@@ -301,15 +329,13 @@ class Device:
         self._retire_listeners.append(fn)
 
     def was_discarded(self, motion_id: int) -> bool:
-        """True when motion `motion_id` was discarded (by one of the last 256 stops, halts or
-        take-overs)."""
+        """True when motion `motion_id` was discarded (by a stop, a halt or a take-over)."""
         return self.discard_reason(motion_id) is not None
 
     def discard_reason(self, motion_id: int) -> str | None:
         """Why motion `motion_id` was discarded ("stop", "servo off" …), None if it was not."""
         with self.lock:
-            return next((why for lo, hi, why in reversed(self._discarded_ids)
-                         if lo <= motion_id <= hi), None)
+            return self._discards.reason(motion_id)
 
     def status(self) -> tuple[int, str, float, int]:
         """(current motion id or 0, its label, its completed fraction, motions queued behind)."""
@@ -387,7 +413,7 @@ class Device:
         self.retired_id = max(self.retired_id, self.current.id)
         if discarded:
             self.discarded += 1
-            self._discarded_ids.append((self.current.id, self.current.id, self._reason))
+            self._discards.add(self.current.id, self.current.id, self._reason)
             self._stop_at = None
             self.rate = self._rate_target = 1.0
         else:
@@ -411,7 +437,7 @@ class Device:
         """A new id, retired at once as discarded (a stop overtook it)."""
         self.last_id += 1
         self.discarded += 1
-        self._discarded_ids.append((self.last_id, self.last_id, self._reason))
+        self._discards.add(self.last_id, self.last_id, self._reason)
         self.retired_id = max(self.retired_id, self.last_id)
         self.changed.notify_all()
         return self.last_id
@@ -425,7 +451,7 @@ class Device:
     def _retire_queue(self) -> None:
         if self.queue:
             self.discarded += len(self.queue)
-            self._discarded_ids.append((self.queue[0].id, self.queue[-1].id, self._reason))
+            self._discards.add(self.queue[0].id, self.queue[-1].id, self._reason)
             self.retired_id = max(self.retired_id, self.queue[-1].id)
             self.queue.clear()
             self.changed.notify_all()

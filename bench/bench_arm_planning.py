@@ -83,7 +83,7 @@ def main() -> None:
         start = ArmSetpoint(np.radians(start_deg), 0.0)
         walls, cpus, r = [], [], None
         for _ in range(RUNS + 1):                 # the first run warms up
-            arm.device.halt(start)
+            arm.device.halt(start, "the next run")
             t0, c0 = time.perf_counter(), time.thread_time()
             r = call()
             walls.append(time.perf_counter() - t0)

@@ -201,3 +201,49 @@ def test_the_slowest_joint_speed_still_moves_and_stops(arm, executor):  # noqa: 
     assert arm.stop().ok
     run_until(executor, lambda: not arm.device.busy, arm.accel_time_joint + 0.1)
     trace.check()
+
+
+def _accepted_then_run(arm, executor, reply):  # noqa: F811
+    """A move is refused, or it runs to its end without the soft-limit watch's alarm."""
+    if reply.code == R.VALUE_ERR:
+        return "refused"
+    assert reply.ok, reply
+    run_until(executor, lambda: not arm.device.busy, 60.0)
+    assert not arm.alarms, arm.alarms
+    return "ran"
+
+
+def test_a_ptp_move_accepted_never_trips_the_cartesian_limit_watch(arm, executor):  # noqa: F811
+    """A far control point bulges between the accept check's samples (one per degree): a limit
+    on the samples' extreme was accepted, then the run crossed it by 0.12 mm (alarm 0x5)."""
+    start = [-85.5, 40.0, 0.0, -40.0, 0.0, 90.0, 90.0]
+    assert arm.move_ptp_joint_abs(start).ok
+    run_until(executor, lambda: not arm.device.busy, 30.0)
+    assert arm.set_control_point_offset(hg(dx=2000.0, dz=2000.0)).ok
+    step = np.radians([91.0] + [0.0] * 6)
+    qs = np.radians(start) + np.linspace(0.0, 1.0, 92)[:, None] * step
+    sampled = arm.frames.tool_of(arm.kin.flange_many(qs))[:, 0, 3].max() * 1000.0
+    assert arm.set_soft_limit_cartesian((sampled, -10000.0), (10000.0, -10000.0),
+                                        (10000.0, -10000.0)).ok
+    assert _accepted_then_run(arm, executor, arm.move_ptp_joint_rel(list(np.degrees(step)))) \
+        == "refused"
+
+
+def test_a_cp_move_accepted_never_trips_the_joint_limit_watch(arm, executor):  # noqa: F811
+    """The accept check samples the joint spline 4× per knot: a limit just past the samples'
+    extreme was accepted, then the run crossed it by 1e-6° (alarm 0x4)."""
+    assert arm.set_speed_cartesian(100).ok
+    assert arm.move_ptp_joint_abs([0.0, 40.0, 0.0, -80.0, 0.0, 40.0, 0.0]).ok
+    run_until(executor, lambda: not arm.device.busy, 30.0)
+    move = (hg(dy=400.0, dz=-300.0), 0.0, 0)
+    assert arm.move_linear_cartesian_rel(move).ok               # planned once, to learn its path
+    spline = arm.device.queue[-1].motion.path
+    dense = np.degrees(spline.spline(np.linspace(0.0, 1.0, 4 * len(spline.ss))))
+    fine = np.degrees(spline.spline(np.linspace(0.0, 1.0, 200001)))
+    assert arm.stop().ok
+    run_until(executor, lambda: not arm.device.busy, 5.0)
+    assert dense[:, 3].min() - fine[:, 3].min() > 2e-6          # the samples miss the extreme
+    limits = [tuple(x) for x in arm.get_soft_limit_joint().values["soft_limit"]]
+    limits[3] = (limits[3][0], dense[:, 3].min() - 1e-10)
+    assert arm.set_soft_limit_joint(limits).ok
+    assert _accepted_then_run(arm, executor, arm.move_linear_cartesian_rel(move)) == "refused"

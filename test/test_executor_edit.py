@@ -2,7 +2,7 @@
 a halt discards everything at once and rests where it is told."""
 from dataclasses import dataclass
 
-from acti_motion.executor import Device
+from acti_motion.executor import Device, DiscardLog
 
 
 @dataclass
@@ -75,3 +75,22 @@ def test_submit_all_queues_a_sequence_whole_or_not_at_all():
     except ValueError:
         pass
     assert d.queue_length == 3 and d.last_id == 3 and d.queued_end == 3.0
+
+
+def test_a_discarded_motion_stays_discarded_after_many_more_discards():
+    """The reasons of the last 256 discards are kept; whether a motion was discarded, always
+    (an old discarded motion's wait said completed once 256 more discards had come)."""
+    d = Device("toy", 4, 0.0)
+    first = d.submit(lambda s: Ramp1D(s, 1.0, 1.0), "a")
+    d.stop(0.1, "stop")                                        # at rest: discarded at once
+    done = d.submit(lambda s: Ramp1D(s, 1.0, 1.0), "b")
+    while d.busy:
+        d.tick(None, 0.5)
+    for _ in range(300):
+        d.submit(lambda s: Ramp1D(s, 1.0, 1.0), "c")
+        d.stop(0.1, "servo off")
+        while d.busy:
+            d.tick(None, 0.5)
+    assert d.discard_reason(first) == DiscardLog.FORGOTTEN and d.was_discarded(first)
+    assert not d.was_discarded(done) and d.discard_reason(d.last_id) == "servo off"
+    assert not d.was_discarded(d.last_id + 1) and not d.was_discarded(10 ** 9)
