@@ -247,3 +247,18 @@ def test_a_cp_move_accepted_never_trips_the_joint_limit_watch(arm, executor):  #
     limits[3] = (limits[3][0], dense[:, 3].min() - 1e-10)
     assert arm.set_soft_limit_joint(limits).ok
     assert _accepted_then_run(arm, executor, arm.move_linear_cartesian_rel(move)) == "refused"
+
+
+@pytest.mark.parametrize("call", [
+    lambda a: a.move_ptp_joint_abs([999.0] + [0.0] * 6),
+    lambda a: a.move_ptp_cartesian_abs((hg(dx=5000.0), 0.0, 0)),
+    lambda a: a.move_linear_cartesian_abs((hg(dx=5000.0), 0.0, 0)),
+    lambda a: a.move_circular_cartesian_abs((hg(dx=5000.0), 0.0, 0), (hg(dx=300.0), 0.0, 0))])
+def test_a_bad_absolute_target_is_value_err_on_a_full_queue_too(arm, call):
+    """Known without the start: said before the queue is looked at (as a relative step that
+    no start can take; FULL_MOTION_QUEUE_ERR hid it)."""
+    while arm.move_ptp_joint_rel([0.0] * 6 + [0.1]).ok:
+        pass
+    assert arm.device.full
+    r = call(arm)
+    assert r.code == R.VALUE_ERR and r.comment, r

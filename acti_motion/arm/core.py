@@ -580,6 +580,7 @@ class ArmCore:
     def move_ptp_joint_abs(self, joint_points: list[float]) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
         goal = np.radians(finite_vector(joint_points, self.axis_count, "joint_points"))
+        self._check_joint_target(np.degrees(goal), "move_ptp_joint_abs")   # before the queue
         return self.queue_joint_move(lambda start: goal, "move_ptp_joint_abs")
 
     @returns(*MOVE)
@@ -600,6 +601,7 @@ class ArmCore:
     def move_ptp_cartesian_abs(self, car_point: tuple) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
         target, psi = self._car_point(car_point, "car_point")
+        self._check_target(target, "move_ptp_cartesian_abs")
         return self._queue_ptp_cartesian(lambda P0: target, "move_ptp_cartesian_abs", psi=psi)
 
     @returns(*MOVE)
@@ -613,6 +615,7 @@ class ArmCore:
     def move_linear_cartesian_abs(self, car_point: tuple) -> dict:
         self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
         target, psi = self._car_point(car_point, "car_point")
+        self._check_target(target, "move_linear_cartesian_abs")
         return self.queue_cartesian(lambda P0: LinePath(P0, target), "move_linear_cartesian_abs",
                                      psi=psi)
 
@@ -630,6 +633,8 @@ class ArmCore:
         self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
         via, _ = self._car_point(car_point_r, "car_point_r")
         target, psi = self._car_point(car_point_t, "car_point_t")
+        self._check_target(via, "move_circular_cartesian_abs: car_point_r")
+        self._check_target(target, "move_circular_cartesian_abs")
         return self.queue_cartesian(lambda P0: ArcPath(P0, via[:3, 3], target),
                                      "move_circular_cartesian_abs", psi=psi)
 
@@ -780,6 +785,13 @@ class ArmCore:
         elbow = _in_range(car_point[1], -ELBOW_DEG, ELBOW_DEG, f"{name}.elbow", "°")
         return pose, math.radians(elbow)
 
+    def _check_target(self, target: np.ndarray, label: str, frames: Frames | None = None) -> None:
+        """A target (4×4, m) within the Cartesian soft limit and the arm's reach, else VALUE_ERR.
+        Absolute targets are checked before the queue is looked at (a full queue would have
+        hidden it), and again when planned, with the frames in force then."""
+        self._check_cartesian_positions(target[None, :3, 3] * 1000.0, label)
+        self._check_reach(target[None, :3, 3], self.frames if frames is None else frames, label)
+
     def _check_reach(self, positions: np.ndarray, frames: Frames, label: str) -> None:
         """Control-point positions (robot frame, m) no farther from the shoulder than the arm,
         hand and control-point offset reach, else VALUE_ERR: checked before any IK or planning,
@@ -868,8 +880,7 @@ class ArmCore:
         def goal_of(start: ArmSetpoint) -> np.ndarray:
             frames = self.frames          # read while planning: the offsets wait for it
             target = target_of(frames.tool_of(kin.flange(start.joints)))
-            self._check_cartesian_positions(target[None, :3, 3] * 1000.0, label)
-            self._check_reach(target[None, :3, 3], frames, label)
+            self._check_target(target, label, frames)
             flange = frames.flange_of(target)
             goal_psi, goal_turn = self._elbow_goal(start.joints, flange, psi, turn)
             try:
