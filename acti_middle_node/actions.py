@@ -107,12 +107,16 @@ class MotionActions:
             return True if device.is_over(motion_id) else None
 
         def feedback() -> None:
+            """This goal's move: its progress once it runs (0 while queued)."""
             current, _, progress, queued = device.status()
             goal_handle.publish_feedback(Move.Feedback(
-                motion_id=current, progress=progress if current == motion_id else 0.0,
+                motion_id=motion_id, progress=progress if current == motion_id else 0.0,
                 queue_length=queued))
         await self.watch.until(over, feedback)
-        result.completed = not device.was_discarded(motion_id)
+        why = device.discard_reason(motion_id)
+        result.completed = why is None
+        if why is not None:
+            result.return_id.comment = f"discarded: {why}"
         self._where(result)
         if canceled:
             goal_handle.canceled()

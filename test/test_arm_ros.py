@@ -165,6 +165,8 @@ def test_canceling_a_move_stops_the_arm(ros, arm_node, move):
     move.spin(handle.cancel_goal_async())
     status, result = move.result(handle)
     assert status == GoalStatus.STATUS_CANCELED and not result.completed
+    assert result.return_id.comment == "discarded: stop"
+    assert {f.motion_id for f in feedback} == {result.motion_id}
     state = call(ros, "get_state", srv.GetState).state
     assert state & 0x02 == 0 and state & 0x01
 
