@@ -21,7 +21,6 @@ GRIPPER_JOINTS = ("gripper_finger_left_joint", "gripper_finger_right_joint")
 WHEEL_JOINTS = ("left_wheel_joint", "right_wheel_joint")
 BUMPER_LINK = "bumper"
 CASTER_LINKS = ("front_caster", "rear_caster")
-SOLVER_RESIDUAL = 1e-9
 
 HELD = "held"                          # the wheels' motor target while `hold_wheels`
 
@@ -60,13 +59,12 @@ class World:
         p.setAdditionalSearchPath(pybullet_data.getDataPath())
         p.setGravity(0, 0, -9.81)
         p.setTimeStep(time_step)
-        # The contact solver runs its iterations until the residual is this small (PyBullet stops
-        # at 1e-7): at its default the wheels crept under the arm's weight in turns in place, the
-        # base moving 1–14 mm per turn that odometry cannot see (now 0.3–4.6 mm, +12 % step time).
-        p.setPhysicsEngineParameter(solverResidualThreshold=SOLVER_RESIDUAL)
         self.plane = p.loadURDF("plane.urdf")
-        # Implicit cylinders: by default PyBullet turns a URDF cylinder into a convex hull, on which
-        # the wheels roll ~2 % farther than 2πr per turn (and the base pitches): odometry was off.
+        # Implicit cylinders: by default PyBullet turns a URDF cylinder into a convex hull (a wheel
+        # on it rolled ~2 % farther than 2πr per turn). The wheels collide as spheres of their
+        # radius (the URDF): a cylinder touches the floor along a line, PyBullet split the load over
+        # 2–4 points by the base's last roll, and in turns in place the wheels crept (the base
+        # moved up to 15 mm per turn, unseen by odometry; now 0.1 mm).
         self.robot = p.loadURDF(urdf_path, [0, 0, 0.1], useFixedBase=False,
                                 flags=pybullet.URDF_USE_INERTIA_FROM_FILE
                                 | pybullet.URDF_USE_IMPLICIT_CYLINDER)
