@@ -27,13 +27,15 @@ def _end_with_parent() -> None:
 
 class NodeProcess:
     """`python -m <module> [args] --ros-args -p <params>` (and a namespace for one robot of a
-    fleet); stopped by PID (SIGINT, then SIGKILL)."""
+    fleet, a parameter file); stopped by PID (SIGINT, then SIGKILL)."""
 
     def __init__(self, module: str, log_path: str, *params: str, args: tuple[str, ...] = (),
-                 namespace: str = "") -> None:
+                 namespace: str = "", params_file: str = "") -> None:
         command = [sys.executable, "-m", module, *args, "--ros-args"]
         if namespace:
             command += ["-r", f"__ns:={namespace}"]
+        if params_file:
+            command += ["--params-file", params_file]
         for p in params:
             command += ["-p", p]
         self.log_path = log_path

@@ -17,13 +17,19 @@ def ros() -> RosClient:
     client.close()
 
 
-def node_fixture(module: str, *params: str, namespace: str = ""):
+def node_fixture(module: str, *params: str, namespace: str = "", params_yaml: str = ""):
     """A module-scoped fixture running one node process (4× real time) for the tests of a file,
-    in `namespace` when given (one robot of a fleet)."""
+    in `namespace` when given (one robot of a fleet), with a parameter file of `params_yaml`."""
     @pytest.fixture(scope="module")
     def fixture(tmp_path_factory):
-        log = str(tmp_path_factory.mktemp(module) / "node.log")
-        node = NodeProcess(module, log, TEST_RATE, *params, namespace=namespace)
+        folder = tmp_path_factory.mktemp(module)
+        params_file = ""
+        if params_yaml:
+            params_file = str(folder / "params.yaml")
+            with open(params_file, "w") as f:
+                f.write(params_yaml)
+        node = NodeProcess(module, str(folder / "node.log"), TEST_RATE, *params,
+                           namespace=namespace, params_file=params_file)
         yield node
         alive = node.alive()
         code = node.stop()

@@ -1,13 +1,18 @@
 """A fleet in one domain: two main jobs in namespaces /robot1 and /robot2, each moved over DDS
 without touching the other, each publishing its own simulated time and joints in its namespace
 (published only while subscribed: these subscriptions start them)."""
+import os
+
 from acti_msgs import srv
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
 from ros_harness import node_fixture, wait_until
 
-robot1 = node_fixture("acti_bringup", namespace="/robot1")
+# the project's parameter file (its nodes' keys match them in any namespace), one value changed
+with open(os.path.join(os.path.dirname(__file__), "..", "config", "acti_ros2.yaml")) as f:
+    PARAMS = f.read().replace("velocity_limit_translation: 1000.0", "velocity_limit_translation: 800.0")
+robot1 = node_fixture("acti_bringup", namespace="/robot1", params_yaml=PARAMS)
 robot2 = node_fixture("acti_bringup", namespace="/robot2")
 
 TARGET = [15.0, 25.0, -10.0, -70.0, 20.0, 45.0, -30.0]
@@ -53,6 +58,14 @@ def test_each_robot_moves_without_touching_the_other(ros, robot1, robot2):
     assert ros.call(srv.GetState, arm("/robot2", "get_state")).state & 0x01 == 0      # servo off
     r = ros.call(srv.VehicleGetState, base("/robot1", "get_state"))
     assert (r.state, r.msg) == (0x019, "Unpowered")
+
+
+def test_a_namespaced_robot_takes_its_parameter_file(ros, robot1, robot2):
+    """The file's keys are /**/vehicle_node …: plain vehicle_node matched only the root namespace,
+    and a fleet robot silently ran on the defaults."""
+    limit = lambda ns: ros.call(srv.VehicleGetVelocityLimit,  # noqa: E731
+                                base(ns, "get_velocity_limit")).vel_limit_t
+    assert (limit("/robot1"), limit("/robot2")) == (800.0, 1000.0)
 
 
 STAMPED = {"clock": (Clock, lambda m: m.clock), "joint_states": (JointState, lambda m: m.header.stamp)}
