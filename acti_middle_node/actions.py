@@ -11,9 +11,8 @@ from typing import Any
 
 from acti_msgs.action import Move, WaitMotion
 from acti_msgs.msg import ReturnId
-from rclpy.action import ActionServer
 
-from acti_bringup.serving.adapter import Plane
+from acti_bringup.serving.adapter import Plane, action_server
 from acti_bringup.serving.conversions import fill, to_core
 from acti_bringup.serving.waiting import GoalSlots, accept_cancel, device_watch, wait_for_motion
 from acti_motion.arm.core import ArmCore
@@ -58,9 +57,9 @@ class MotionActions:
         slots = GoalSlots(plane.owner, config.max_action_goals, "max_action_goals")
         cancel = accept_cancel(self.watch)
         self.servers = [
-            ActionServer(plane, WaitMotion, plane.name("wait_motion"), slots.holding(self._wait),
+            action_server(plane, WaitMotion, plane.name("wait_motion"), slots.holding(self._wait),
                          goal_callback=slots.admit, cancel_callback=cancel),
-            ActionServer(plane, Move, plane.name("move"), slots.holding(self._move),
+            action_server(plane, Move, plane.name("move"), slots.holding(self._move),
                          goal_callback=slots.admit, cancel_callback=cancel),
         ]
 

@@ -14,9 +14,9 @@ import threading
 from typing import Any
 
 from acti_msgs.action import RunProgram
-from rclpy.action import ActionServer, CancelResponse, GoalResponse
+from rclpy.action import CancelResponse, GoalResponse
 
-from acti_bringup.serving.adapter import Plane
+from acti_bringup.serving.adapter import Plane, action_server
 from acti_bringup.serving.conversions import fill
 from acti_bringup.serving.waiting import Watch
 from acti_motion.arm.core import ArmCore
@@ -36,7 +36,7 @@ class ProgramAction:
         self._busy = False
         self._current: ProgramRun | None = None
         self._lock = threading.Lock()
-        self.server = ActionServer(plane, RunProgram, plane.name("run_program"), self._execute,
+        self.server = action_server(plane, RunProgram, plane.name("run_program"), self._execute,
                                    goal_callback=self._admit, cancel_callback=self._cancel)
         # the node stops: so does the run. A method returning None: rclpy calls what the
         # callback returns, so a lambda returning a CancelResponse crashed the shutdown

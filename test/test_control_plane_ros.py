@@ -152,6 +152,27 @@ def test_goals_beyond_the_bound_are_rejected_and_stop_is_answered_while_the_rest
     assert arm_wait.offer(motion_id=0).accepted and base_wait.offer(motion_id=0).accepted
 
 
+def test_every_goal_of_a_burst_is_answered(ros, job):
+    """20 goals sent at once: each is answered, the bound's worth accepted and the rest rejected
+    (the goal service kept rclpy's 10 requests: the others had no answer at all)."""
+    from rclpy.action import ActionClient
+    from rclpy.qos import QoSProfile
+    arm_id = arm_long_motion(ros)
+    deep = QoSProfile(depth=100)
+    client = ActionClient(ros.node, WaitMotion, ARM + "wait_motion", goal_service_qos_profile=deep,
+                          result_service_qos_profile=deep)
+    try:
+        assert client.wait_for_server(timeout_sec=30.0)
+        futures = [client.send_goal_async(WaitMotion.Goal(motion_id=arm_id)) for _ in range(20)]
+        assert all(ros.wait(f, 30.0) for f in futures), "a goal had no answer"
+        accepted = [f.result() for f in futures if f.result().accepted]
+        assert len(accepted) == ARM_GOALS
+        assert ros.call(srv.Stop, ARM + "stop").return_id.id == 0
+        assert all(ros.wait(h.get_result_async(), 30.0) for h in accepted)
+    finally:
+        client.destroy()
+
+
 def test_wait_motion_times_out_and_the_motion_goes_on(ros, device):
     motion_id = device.start_long_motion(ros)
     goals = waits(ros, device)

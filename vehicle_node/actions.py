@@ -7,9 +7,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from acti_msgs.action import VehicleWaitMotion
-from rclpy.action import ActionServer
 
-from acti_bringup.serving.adapter import Plane
+from acti_bringup.serving.adapter import Plane, action_server
 from acti_bringup.serving.conversions import fill
 from acti_bringup.serving.waiting import GoalSlots, accept_cancel, device_watch, wait_for_motion
 from acti_motion.vehicle.core import VehicleCore
@@ -27,7 +26,7 @@ class WaitMotionServer:
         self.core = core
         self.watch = device_watch(plane, core.device, 1.0 / config.wait_feedback_rate_hz)
         slots = GoalSlots(plane.owner, config.max_wait_goals, "max_wait_goals")
-        self.server = ActionServer(plane, VehicleWaitMotion, plane.name("wait_motion"),
+        self.server = action_server(plane, VehicleWaitMotion, plane.name("wait_motion"),
                                    slots.holding(self._wait), goal_callback=slots.admit,
                                    cancel_callback=accept_cancel(self.watch))
 
