@@ -4,6 +4,7 @@ without touching the other, each publishing its own simulated time and joints in
 import os
 
 from acti_msgs import srv
+from diagnostic_msgs.msg import DiagnosticArray
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
@@ -89,3 +90,16 @@ def test_each_robot_publishes_its_own_clock_and_joints_in_its_namespace(ros, rob
     finally:
         for s in subs:
             ros.node.destroy_subscription(s)
+
+
+def test_the_shared_diagnostics_name_each_robot(ros, robot1, robot2):
+    names: set[str] = set()
+    sub = ros.node.create_subscription(
+        DiagnosticArray, "/diagnostics",
+        lambda m: names.update((s.name, s.hardware_id) for s in m.status), 10)
+    try:
+        want = {(f"robot{n}/vehicle_node: {what}", f"robot{n}/base")
+                for n in (1, 2) for what in ("battery", "alarms")}
+        assert ros.spin_until(lambda: want <= names, 30.0), names
+    finally:
+        ros.node.destroy_subscription(sub)

@@ -166,10 +166,16 @@ class VehicleNode(Node):
             battery_voltage=core.battery.voltage, num_of_active_alarm=len(core.alarms.active())))
 
     def _publish_diagnostics(self, world: World) -> None:
+        """Entries named like diagnostic_updater's ("vehicle_node: battery"), with the robot's
+        namespace in front ("robot1/vehicle_node: …", hardware "robot1/base"): /diagnostics is
+        the fleet's one topic, and an aggregator keys on the names."""
         core, c = self.core, self.core.config
+        robot = self.get_namespace().strip("/")
+        name, hardware = (f"{robot}/{self.get_name()}", f"{robot}/base") if robot else \
+            (self.get_name(), "base")
         volts = core.battery.voltage
         battery = DiagnosticStatus(
-            name="vehicle_node: battery", hardware_id="base",
+            name=f"{name}: battery", hardware_id=hardware,
             level=(DiagnosticStatus.ERROR if volts < c.battery_cutoff_voltage else
                    DiagnosticStatus.WARN if volts < c.battery_low_voltage else DiagnosticStatus.OK),
             message=f"{volts:.1f} V", values=[
@@ -179,7 +185,7 @@ class VehicleNode(Node):
         active = core.alarms.active()
         faults = [a for a in active if a.type == AlarmType.FAULT]
         alarms = DiagnosticStatus(
-            name="vehicle_node: alarms", hardware_id="base",
+            name=f"{name}: alarms", hardware_id=hardware,
             level=(DiagnosticStatus.ERROR if faults else
                    DiagnosticStatus.WARN if active else DiagnosticStatus.OK),
             message=core.state_string(core.state()),
