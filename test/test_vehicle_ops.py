@@ -397,6 +397,9 @@ def test_pause_reports_busy_until_the_base_is_at_rest(base, executor, trace):  #
     (dict(velocity_limit_rotation=90.0, accel_limit_rotation=2.0, accel_min_rotation=1.0,
           default_accel_rotation=1.0), "would take 45 s"),
     (dict(battery_charge=math.nan), "battery_charge is nan"),
+    # were accepted too (a negative axis read the Joy message from its end)
+    (dict(arrival_error=-1.0), "arrival_error is -1"), (dict(joy_axis_linear=-3), "joy_axis_linear"),
+    (dict(battery_cutoff_voltage=50.0), "must be below battery_low_voltage"),
 ])
 def test_start_up_settings_outside_the_limits_are_rejected(executor, config, words):  # noqa: F811
     with pytest.raises(ValueError, match="vehicle configuration") as refused:

@@ -29,6 +29,7 @@ from acti_motion.arm.core import ArmCore
 from acti_motion.arm.blending import ARM_MOVES, blend_with_previous
 from acti_motion.arm.kinematics import Unreachable, rotate_about
 from acti_motion.arm.poses import compose_relative, hg_to_pose, inverse
+from acti_motion.config_fields import check_ranges, ranged
 from acti_motion.replies import Refused, ReturnCode, value_error
 from acti_motion.arm.trajectories import ArcPath, ArmSetpoint, LinePath
 from strolic.codes import (I2, NUMERIC_TAGS, POSE, R4, R8, Array, Num, Pose, Str, TagHead,
@@ -69,8 +70,9 @@ PLANES = {1: 2, 2: 0, 3: 1}    # CMOVE1 plane → its normal axis: xy → z, yz 
 @dataclass
 class ProgramDefaults:
     """The modal settings a program starts with (the node's parameters)."""
-    program_jspeed: float = 20.0       # JSPEED at the start of a program [%]
-    program_speed: float = 100.0       # SPEED at the start of a program [mm/s]
+    program_jspeed: float = ranged(20.0, 0.0, 100.0)    # JSPEED at the start of a program [%]
+    # SPEED at the start of a program [mm/s] (at most the arm's max_speed_translation)
+    program_speed: float = ranged(100.0, 0.0, 10000.0)
 
 
 class Flag(Exception):
@@ -170,12 +172,14 @@ class RobotHost(Host):
                  defaults: ProgramDefaults | None = None, echo: bool = False) -> None:
         super().__init__()
         d = defaults or ProgramDefaults()
+        check_ranges(d, "program defaults")
         self.arm = arm
         self.io = io or RobotIO()
         self.step = step
         self.echo = echo
         self.lines: list[str] = []
-        self.jspeed, self.speed = d.program_jspeed, d.program_speed
+        self.jspeed = d.program_jspeed
+        self.speed = min(d.program_speed, arm.max_speed_cartesian[0])   # what SPEED would take
         self.accel: tuple[str, float] | None = None     # ("percent" | "time", value)
         self.decel: tuple[str, float] | None = None
         self.accuracy = 0.0                               # SACC, mm

@@ -37,27 +37,32 @@ class VehicleConfig:
     # degree: the largest rotation a move or set_position asks
     turn_limit: float = ranged(3600.0, 1.0, 36000.0)
     jog_timeout: int = 500                       # ms from the last jog command to the stop
-    joy_axis_linear: int = 1                     # sensor_msgs/Joy axis for forward speed …
-    joy_axis_angular: int = 0                    # … and for the yaw rate (left stick)
-    joy_enable_button: int = -1                  # a button that must be held (-1: none)
+    joy_axis_linear: int = ranged(1, 0, 63)      # sensor_msgs/Joy axis for forward speed …
+    joy_axis_angular: int = ranged(0, 0, 63)     # … and for the yaw rate (left stick)
+    joy_enable_button: int = ranged(-1, -1, 127)  # a button that must be held (-1: none)
     io_config: str = ""                          # I/O ids (YAML); "" = config/vehicle_io.yaml
-    battery_capacity_wh: float = 960.0           # battery capacity [Wh]
+    battery_capacity_wh: float = ranged(960.0, 1.0, 1.0e6)  # battery capacity [Wh]
     battery_charge: float = ranged(1.0, 0.0, 1.0)  # state of charge at start-up, 0 … 1
-    battery_low_voltage: float = 46.0            # V: warning 110 below
-    battery_cutoff_voltage: float = 44.0         # V: fault 201 below (servo off)
+    battery_low_voltage: float = ranged(46.0, 0.0, 1000.0)     # V: warning 110 below
+    battery_cutoff_voltage: float = ranged(44.0, 0.0, 1000.0)  # V: fault 201 below (servo off)
     # V: a battery alarm's cause is gone this far above its level
     battery_hysteresis: float = ranged(1.0, 0.0, 100.0)
-    stuck_error: float = 100.0                   # mm of tracking error …
-    stuck_angle: float = 20.0                    # … or degrees of heading error …
+    stuck_error: float = ranged(100.0, 1.0, 100000.0)  # mm of tracking error …
+    stuck_angle: float = ranged(20.0, 0.1, 360.0)  # … or degrees of heading error …
     stuck_time: float = ranged(0.3, 0.0, 10.0)  # … held this long (s): the base is Stuck
-    arrival_error: float = 20.0                  # mm: a move that ends farther from its target is Stuck …
-    arrival_angle: float = 3.0                   # … or more degrees off its heading
+    arrival_error: float = ranged(20.0, 0.1, 100000.0)  # mm: a move that ends farther from its target is Stuck …
+    arrival_angle: float = ranged(3.0, 0.01, 180.0)  # … or more degrees off its heading
 
 
 def check_config(c: VehicleConfig) -> None:
-    """ValueError unless every ranged field is within its range and a stop from the velocity
-    limit at the acceleration limit takes at most MAX_STOP_S, in translation and in rotation."""
+    """ValueError unless every ranged field is within its range, the battery's cut-off is below
+    its warning level, and a stop from the velocity limit at the acceleration limit takes at most
+    MAX_STOP_S, in translation and in rotation."""
     check_ranges(c, "vehicle configuration")
+    if not c.battery_cutoff_voltage < c.battery_low_voltage:
+        raise ValueError(f"vehicle configuration: battery_cutoff_voltage ({c.battery_cutoff_voltage:g}"
+                         f" V) must be below battery_low_voltage ({c.battery_low_voltage:g} V): the "
+                         "warning comes before the cut-off")
     for axis, v, a, unit in (
             ("translation", c.velocity_limit_translation, c.accel_limit_translation, "mm/s"),
             ("rotation", c.velocity_limit_rotation, c.accel_limit_rotation, "degree/s")):
