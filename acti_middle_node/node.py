@@ -11,7 +11,7 @@ from rclpy.node import Node
 
 from acti_bringup.serving.adapter import Plane, serve_operations
 from acti_bringup.serving.parameters import Setting, declare_config, sync_parameters
-from acti_bringup.serving.spinning import steady_timer
+from acti_bringup.serving.spinning import steady_timer, warn_of_namesakes
 from acti_bringup.simulation import Simulation
 from acti_middle_node.actions import ActionConfig, MotionActions
 from acti_middle_node.operations import OPERATIONS
@@ -66,6 +66,7 @@ class ArmNode(Node):
         self.programs = ProgramAction(self.goals, self.core, actions.feedback_rate_hz,
                                       declare_config(self, ProgramDefaults))
         self._state = self.create_publisher(ArmState, "~/state", 10)
+        warn_of_namesakes(self, self._state)
         steady_timer(self, 1.0 / topics.state_rate_hz, self._publish_state)
 
     def _publish_state(self) -> None:

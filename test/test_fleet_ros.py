@@ -8,7 +8,7 @@ from diagnostic_msgs.msg import DiagnosticArray
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
-from ros_harness import node_fixture, wait_until
+from ros_harness import TEST_RATE, NodeProcess, node_fixture, wait_until
 
 # the project's parameter file (its nodes' keys match them in any namespace), one value changed
 with open(os.path.join(os.path.dirname(__file__), "..", "config", "acti_ros2.yaml")) as f:
@@ -103,3 +103,14 @@ def test_the_shared_diagnostics_name_each_robot(ros, robot1, robot2):
         assert ros.spin_until(lambda: want <= names, 30.0), names
     finally:
         ros.node.destroy_subscription(sub)
+
+
+def test_a_second_job_in_a_robots_namespace_is_reported(ros, robot1, robot2, tmp_path):
+    """It starts (the graph can list a job that has just ended), and both say what is wrong."""
+    twin = NodeProcess("acti_bringup", str(tmp_path / "twin.log"), TEST_RATE,
+                       "view_enabled:=false", namespace="/robot2")
+    try:
+        said = "another job runs as /robot2/vehicle_node"
+        assert wait_until(lambda: said in twin.log() and said in robot2.log(), 30.0), twin.log()
+    finally:
+        twin.stop()

@@ -105,11 +105,25 @@ def test_the_nodes_end_cleanly_on_a_signal(ros, tmp_path, module, up, signum):
     assert "Traceback" not in node.log(), node.log()
 
 
+def test_nodes_of_one_name_are_one_line_and_exit_status_2(tmp_path):
+    """`-r __node:=…` renames every node of the job: their services clashed with a traceback."""
+    node = NodeProcess("acti_bringup", str(tmp_path / "node.log"), "view_enabled:=false",
+                       args=("--ros-args", "-r", "__node:=acti_middle_node"))
+    try:
+        assert node.proc.wait(timeout=60.0) == 2, node.log()
+    finally:
+        node.stop()
+    fatal = [line for line in node.log().splitlines() if "[FATAL]" in line]
+    assert len(fatal) == 1 and "do two nodes of the process have one name?" in fatal[0]
+    assert "Traceback" not in node.log(), node.log()
+
+
 @pytest.mark.parametrize("module, param, namespace, words", [
     ("vehicle_node", "rate_hz:=-1.0", "", "rate_hz out of range"),
     ("acti_middle_node", "nice:=-30", "", "nice"),
     ("acti_bringup", "queue_size:=2.5", "", "queue_size"),
-    ("vehicle_node", "stuck_error:=.nan", "", "stuck_error = nan: it must be finite"),
+    ("vehicle_node", "velocity_min_translation:=.nan", "", "velocity_min_translation = nan: it must be finite"),
+    ("vehicle_node", "stuck_error:=.nan", "", "stuck_error out of range"),
     ("vehicle_node", "accel_limit_translation:=10.0", "", "would take 100 s"),
     ("acti_bringup", "initial_joints_deg:=[0.0,30.0,0.0,-60.0,0.0,.inf,0.0]", "",
      "initial_joints_deg = [0.0, 30.0, 0.0, -60.0, 0.0, inf, 0.0]: it must be finite"),

@@ -27,6 +27,7 @@ from tf2_msgs.msg import TFMessage
 
 from acti_bringup.serving.adapter import Plane, serve_operations
 from acti_bringup.serving.parameters import declare_config
+from acti_bringup.serving.spinning import warn_of_namesakes
 from acti_bringup.simulation import Simulation
 from acti_bringup.visual.transforms import planar_transform, tf_publisher
 from acti_motion.vehicle.paths import Odometry as WheelOdometry, Pose2D
@@ -106,6 +107,7 @@ class VehicleNode(Node):
         self._tf = tf_publisher(self) if self.frames.odom_tf else None
         self._truth = self.create_publisher(Odometry, "~/ground_truth", 10)
         self._state = self.create_publisher(VehicleStatus, "~/state", 10)
+        warn_of_namesakes(self, self._state)
         self._diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self._cmd_vel_clamped = False
         # commands that move the base arrive on the motion plane, like the move services

@@ -29,6 +29,7 @@ from rclpy.experimental import EventsExecutor
 from rclpy.logging import get_logger
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
+from rclpy.publisher import Publisher
 from rclpy.timer import Timer
 
 from acti_bringup.serving.responses import LateResponses
@@ -83,9 +84,25 @@ def build_or_exit(build: Callable[[], T], name: str) -> T:
     or of the wrong type, settings that contradict each other) ends the process with one line that
     says what, and exit status 2: a configuration error, not a traceback."""
     try:
-        return build()
+        built = build()
+        warn_of_unknown_parameters(built if isinstance(built, tuple) else (built,))
+        return built
     except (ValueError, InvalidParameterTypeException, InvalidParameterValueException) as e:
         _cannot_start(name, e)
+    except RCLError as e:       # a name clash: `-r __node:=x` renames every node of the process
+        _cannot_start(name, f"{e} (do two nodes of the process have one name? `-r __node:=…` "
+                            "renames every one of them; `-r vehicle_node:__node:=…` one)")
+
+
+def warn_of_unknown_parameters(nodes: tuple[Node, ...]) -> None:
+    """Say which settings given (-p, --params-file) no node of the process has: most likely
+    misspelt (`velocity_limit_translatoin`), and rclpy would ignore them without a word. A `-p`
+    reaches every node of the process, so a name is unknown only when none of them has it."""
+    known = {name for node in nodes for name in node._parameters}
+    given = {name for node in nodes for name in getattr(node, "_parameter_overrides", {})}
+    if given - known and nodes:
+        nodes[0].get_logger().warning("unknown parameters, ignored (misspelt?): "
+                                      + ", ".join(sorted(given - known)))
 
 
 _STEADY = Clock(clock_type=ClockType.STEADY_TIME)
@@ -97,6 +114,28 @@ def steady_timer(node: Node, period: float, callback: Callable[[], None]) -> Tim
     (a node's `use_sim_time` can be set at run time), and with it the state topic, the
     settings mirrored into parameters and every waiting action goal."""
     return node.create_timer(period, callback, clock=_STEADY)
+
+
+NAMESAKE_CHECK_S = 2.0
+
+
+def warn_of_namesakes(node: Node, publisher: Publisher) -> Timer:
+    """Log an error while another node publishes on `publisher`'s topic (its node's own
+    `~/state`): a second job started in the same namespace, and clients' calls reach either
+    one. Said once each time it starts, from the graph every NAMESAKE_CHECK_S; not a refusal to
+    start, since the graph can still list a node that has just ended."""
+    topic, seen = publisher.topic_name, 1
+
+    def check() -> None:
+        nonlocal seen
+        count = node.count_publishers(topic)
+        if count > 1 and seen <= 1:
+            node.get_logger().error(
+                f"{count} nodes publish {topic}: another job runs as "
+                f"{node.get_fully_qualified_name()}, and clients reach either one (give each "
+                "robot its own namespace: -r __ns:=/robotN)")
+        seen = count
+    return steady_timer(node, NAMESAKE_CHECK_S, check)
 
 
 class SpinLoop:
