@@ -69,6 +69,8 @@ class LiveView:
         self._joint_names = self.urdf.get_actuated_joint_names()
         self.trail: deque[np.ndarray] = deque(maxlen=trail_points)
         self.path: deque[np.ndarray] = deque(maxlen=trail_points)
+        self._lines: dict[str, Any] = {}          # the trails' scene nodes
+        self._watched = False
         self.frames = 0
         self._panel_text = ""
         self._shown_targets: tuple = ()
@@ -123,9 +125,7 @@ class LiveView:
             deadline = max(deadline + self.period, time.monotonic() - self.period)
             if self._stop.wait(max(0.0, deadline - time.monotonic())):
                 return
-            watched = bool(self.server.get_clients())
-            self.reader.sampler.active = watched
-            if not watched:
+            if not self.watching(bool(self.server.get_clients())):
                 continue                    # nobody looks: costs nothing
             try:
                 self.update(self.reader.read())
@@ -134,6 +134,23 @@ class LiveView:
                 if not failed:
                     self.log(f"view update failed: {type(e).__name__}: {e}")
                 failed = True
+
+    def watching(self, watched: bool) -> bool:
+        """Whether a page is open now (the world is sampled only then). The first page after a
+        time nobody looked restarts the trails: nothing was recorded meanwhile, and a line from
+        the last point before to the first after would cut across whatever the robot did."""
+        self.reader.sampler.active = watched
+        if watched and not self._watched:
+            self._restart_trails()
+        self._watched = watched
+        return watched
+
+    def _restart_trails(self) -> None:
+        self.trail.clear()
+        self.path.clear()
+        for line in self._lines.values():
+            line.remove()
+        self._lines.clear()
 
     def update(self, s: ViewSample) -> None:
         """Pose the robot, extend the trails, show the targets; refresh the panel now and then."""
@@ -152,10 +169,10 @@ class LiveView:
                 self.robot.position = s.world.base_position
                 self.robot.wxyz = (w, x, y, z)
                 self.urdf.update_cfg(cfg)
-            if trail_grew:
-                _polyline(scene, "/trail/control_point", self.trail, ORANGE)
-            if path_grew:
-                _polyline(scene, "/trail/odometry", self.path, BLUE)
+            for name, points, grew, color in (("/trail/control_point", self.trail, trail_grew, ORANGE),
+                                              ("/trail/odometry", self.path, path_grew, BLUE)):
+                if grew and len(points) >= 2:
+                    self._lines[name] = _polyline(scene, name, points, color)
             if targets != self._shown_targets:      # sent only when they change
                 self._shown_targets = targets
                 _points(scene, "/targets/arm", s.arm_targets, GREEN, 0.03)
@@ -192,11 +209,9 @@ def _extend(trail: deque, point: np.ndarray, step: float) -> bool:
     return True
 
 
-def _polyline(scene: Any, name: str, points: deque, color: tuple[int, int, int]) -> None:
-    if len(points) < 2:
-        return
+def _polyline(scene: Any, name: str, points: deque, color: tuple[int, int, int]) -> Any:
     p = np.asarray(points, np.float32)
-    scene.add_line_segments(name, np.stack([p[:-1], p[1:]], axis=1), color, thickness=0.006)
+    return scene.add_line_segments(name, np.stack([p[:-1], p[1:]], axis=1), color, thickness=0.006)
 
 
 def _points(scene: Any, name: str, points: list, color: tuple[int, int, int],

@@ -75,8 +75,8 @@ class ViewSample:
     world: WorldSample
     control_point: np.ndarray                 # world frame, m
     arm_targets: list[np.ndarray] = field(default_factory=list)   # world frame, m
-    odometry: tuple[float, float, float] = (0.0, 0.0, 0.0)        # x, y (m), theta (rad)
-    base_targets: list[tuple[float, float]] = field(default_factory=list)   # odometry frame, m
+    odometry: tuple[float, float, float] = (0.0, 0.0, 0.0)   # x, y (m), theta (rad): odom frame
+    base_targets: list[tuple[float, float]] = field(default_factory=list)   # odom frame, m
     arm: ArmPanel | None = None
     base: BasePanel | None = None
 
@@ -139,9 +139,12 @@ class Reader:
 
     def _read_base(self, sample: ViewSample) -> None:
         v = self.vehicle
-        pose = v.odometry.pose
-        sample.odometry = (pose.x, pose.y, pose.theta)
-        sample.base_targets = [(end.x, end.y) for end in queued_ends(v.device)]
+        pose = v.odometry.pose                      # the spec's position (set_position's frame)
+        odom, frame = v.odometry.continuous()       # odom: the world's frame where the base started
+        sample.odometry = (odom.x, odom.y, odom.theta)
+        to_odom = frame.inverse()
+        sample.base_targets = [(p.x, p.y) for p in (to_odom.compose(end)
+                                                   for end in queued_ends(v.device))]
         state = v.state()
         sample.base = BasePanel(int(state), v.state_string(state),
                                 (1000.0 * pose.x, 1000.0 * pose.y, math.degrees(pose.theta)),

@@ -117,6 +117,45 @@ def test_snapshot_refuses_what_it_cannot_do_with_one_line(tmp_path, capsys, args
     assert words in capsys.readouterr().err
 
 
+def test_the_odometry_path_and_base_targets_are_drawn_in_the_odom_frame(robot):
+    """set_position moves the spec's position frame, not the world: the path (and a target)
+    jumped 2 m and ran the wrong way after it."""
+    executor, _arm, base, reader = robot
+    assert base.set_power(True).ok and base.set_servo(True).ok
+    for _ in range(50):
+        executor.step()
+    before = reader.read().odometry
+    assert base.set_position((-1700.0, 800.0, 180.0)).ok
+    assert base.move_forward(1500.0).ok
+    s = reader.read()
+    assert np.allclose(s.odometry, before, atol=1e-6)
+    x, y = s.base_targets[-1]                     # 1.5 m ahead of where the base is, in odom
+    assert abs(x - before[0] - 1.5) < 1e-3 and abs(y - before[1]) < 1e-3
+    assert s.base.position_mm_deg[:2] == pytest.approx((-1700.0, 800.0), abs=1e-6)
+
+
+def test_trails_restart_when_a_page_opens_after_nobody_looked(robot):
+    from acti_sim.world import URDF_PATH
+    from acti_view.live import LiveView
+    executor, arm, _base, reader = robot
+    view = LiveView(reader, {}, URDF_PATH, "127.0.0.1", 0, 25.0, 100)
+    try:
+        assert view.watching(True)
+        assert arm.servo_on().ok and arm.set_speed_joint(50).ok
+        assert arm.move_ptp_joint_rel([40.0] + [0.0] * 6).ok
+        for _ in range(40):
+            for _ in range(10):
+                executor.step()
+            view.update(reader.read())
+        assert len(view.trail) > 5 and view._lines
+        assert not view.watching(False)
+        assert view.watching(True) and not view.trail and not view.path and not view._lines
+        view.update(reader.read())
+        assert len(view.trail) == 1
+    finally:
+        view.server.stop()
+
+
 def test_live_view_poses_the_robot_at_its_rate_for_a_connected_page(robot):
     """A websocket client speaking viser's own messages stands in for the page here (the
     browser test opens the real one): it says where its camera is, as a page does on connect;
