@@ -4,6 +4,8 @@ import math
 import time
 from contextlib import contextmanager
 
+import pytest
+
 from acti_msgs import srv
 from acti_msgs.msg import VehicleAlarm, VehiclePoint, VehiclePosition, VehicleStatus, VehicleVelocity
 from diagnostic_msgs.msg import DiagnosticArray
@@ -133,6 +135,9 @@ def test_topics_state_diagnostics_odom_and_cmd_vel(ros, vehicle):
         assert 0.05 < moved < 1.2                                # metres (REP 103)
         truth = got["truth"][-1].pose.pose.position
         assert math.hypot(truth.x - p1.x, truth.y - p1.y) < 0.05
+        # base_link is on the wheel axle, a wheel radius above the floor (it was on the floor:
+        # in RViz the wheels were half in it, and TF 0.1 m off the camera's picture)
+        assert p1.z == pytest.approx(0.1) and truth.z == pytest.approx(0.1, abs=0.005)
     finally:
         for s in subs:
             ros.node.destroy_subscription(s)

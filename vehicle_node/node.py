@@ -57,24 +57,30 @@ def write_success(response: Any, reply: Reply) -> None:
     response.message = reply.comment
 
 
-def odometry_message(stamp: Any, frame: str, pose: Pose2D, v: float, w: float) -> Odometry:
-    """An Odometry of base_link without covariances (the ground truth)."""
+def odometry_message(stamp: Any, frame: str, position: tuple[float, float, float],
+                     orientation: tuple[float, float, float, float], v: float,
+                     w: float) -> Odometry:
+    """An Odometry of base_link (position m, quaternion x y z w), without covariances."""
     msg = Odometry()
     msg.header.stamp = stamp
     msg.header.frame_id = frame
     msg.child_frame_id = "base_link"
-    msg.pose.pose.position.x, msg.pose.pose.position.y = pose.x, pose.y
-    msg.pose.pose.orientation.z = math.sin(pose.theta / 2)
-    msg.pose.pose.orientation.w = math.cos(pose.theta / 2)
+    p, q = msg.pose.pose.position, msg.pose.pose.orientation
+    p.x, p.y, p.z = position
+    q.x, q.y, q.z, q.w = orientation
     msg.twist.twist.linear.x = v
     msg.twist.twist.angular.z = w
     return msg
 
 
-def wheel_odometry_message(stamp: Any, pose: Pose2D, odo: WheelOdometry) -> Odometry:
-    """The continuous dead reckoning in `odom`, with its covariances (row-major 6×6 of x, y, z,
-    roll, pitch, yaw; for the twist: of vx, vy, vz and the three rates)."""
-    msg = odometry_message(stamp, "odom", pose, odo.v, odo.w)
+def wheel_odometry_message(stamp: Any, pose: Pose2D, odo: WheelOdometry,
+                           height: float) -> Odometry:
+    """The continuous dead reckoning in `odom` (base_link `height` above the floor: on the wheel
+    axle), with its covariances (row-major 6×6 of x, y, z, roll, pitch, yaw; for the twist: of
+    vx, vy, vz and the three rates)."""
+    msg = odometry_message(stamp, "odom", (pose.x, pose.y, height),
+                           (0.0, 0.0, math.sin(pose.theta / 2), math.cos(pose.theta / 2)),
+                           odo.v, odo.w)
     pose_cov = [0.0] * 36
     for (i, j), value in zip(((0, 0), (0, 1), (0, 5), (1, 1), (1, 5), (5, 5)),
                              odo.covariance[[0, 0, 0, 1, 1, 2], [0, 1, 2, 1, 2, 2]]):
@@ -149,13 +155,13 @@ class VehicleNode(Node):
     def _publish_odometry(self, world: World) -> None:
         odo, stamp = self.core.odometry, self.simulation.now()
         pose, frame = odo.continuous()
-        self._odom.publish(wheel_odometry_message(stamp, pose, odo))
+        self._odom.publish(wheel_odometry_message(stamp, pose, odo, world.wheel_radius))
         if self._tf is not None:
             self._tf.publish(TFMessage(transforms=[
-                planar_transform(stamp, "odom", "base_link", pose),
+                planar_transform(stamp, "odom", "base_link", pose, world.wheel_radius),
                 planar_transform(stamp, self.frames.position_frame, "odom", frame)]))
         v, w = world.base_twist()
-        self._truth.publish(odometry_message(stamp, "world", Pose2D(*world.base_pose()), v, w))
+        self._truth.publish(odometry_message(stamp, "world", *world.base_link_pose(), v, w))
 
     def _publish_state(self, world: World) -> None:
         core = self.core

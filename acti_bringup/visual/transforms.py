@@ -35,8 +35,9 @@ def link_transform(stamp: Any, t: LinkTransform) -> TransformStamped:
     return msg
 
 
-def planar_transform(stamp: Any, parent: str, child: str, pose: Pose2D) -> TransformStamped:
-    """`child` at a floor pose (x, y, yaw) in `parent`."""
+def planar_transform(stamp: Any, parent: str, child: str, pose: Pose2D,
+                     height: float = 0.0) -> TransformStamped:
+    """`child` at a floor pose (x, y, yaw) in `parent`, `height` above it."""
     return link_transform(stamp, LinkTransform(
-        parent, child, (pose.x, pose.y, 0.0),
+        parent, child, (pose.x, pose.y, height),
         (0.0, 0.0, math.sin(pose.theta / 2), math.cos(pose.theta / 2))))
