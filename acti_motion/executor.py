@@ -465,6 +465,13 @@ class Device:
 StepListener = Callable[[World], None]
 
 
+@dataclass
+class _Listener:
+    every: float        # steps between two calls, on average
+    due: float          # the step count of the next call
+    fn: StepListener
+
+
 class MotionExecutor:
     """Steps the world (at its own fixed time step) on a thread of its own, `real_time_factor`
     times faster than wall time (0: as fast as it can), and advances every device each step."""
@@ -479,7 +486,7 @@ class MotionExecutor:
         self.real_time_factor = real_time_factor
         self.devices: dict[str, Device] = {}
         self._before: list[StepListener] = []
-        self._after: list[tuple[int, StepListener]] = []
+        self._after: list[_Listener] = []
         self._thread: threading.Thread | None = None
         self._running = threading.Event()
         self.steps = 0
@@ -494,13 +501,16 @@ class MotionExecutor:
         """Run fn(world) on the simulation thread before the devices are advanced."""
         self._before.append(fn)
 
-    def after_step(self, fn: StepListener, every: int = 1) -> None:
-        """Run fn(world) on the simulation thread after every `every`-th physics step."""
-        self._after.append((max(1, every), fn))
+    def after_step(self, fn: StepListener, every: float = 1.0) -> None:
+        """Run fn(world) on the simulation thread after every `every`-th physics step. A
+        fractional `every` alternates between the whole numbers around it, so that the rate is
+        kept on average (100 Hz at 250 Hz: every 2, 3, 2, 3 … steps; rounding gave 125 Hz)."""
+        every = max(1.0, every)
+        self._after.append(_Listener(every, self.steps + every, fn))
 
-    def steps_per_period(self, rate_hz: float) -> int:
-        """The `every` of a listener that runs at about rate_hz (at most once a step)."""
-        return max(1, round(1.0 / (rate_hz * self.dt)))
+    def steps_per_period(self, rate_hz: float) -> float:
+        """The `every` of a listener that runs at rate_hz (at most once a step)."""
+        return max(1.0, 1.0 / (rate_hz * self.dt))
 
     def step(self) -> None:
         """One control cycle: listeners, devices, physics. Used by the thread and by unit tests."""
@@ -511,9 +521,10 @@ class MotionExecutor:
             device.tick(world, self.dt)
         world.step()
         self.steps += 1
-        for every, fn in self._after:
-            if self.steps % every == 0:
-                fn(world)
+        for listener in self._after:
+            if self.steps >= listener.due - 1e-9:
+                listener.due += listener.every
+                listener.fn(world)
 
     @property
     def running(self) -> bool:

@@ -1,8 +1,12 @@
-"""Device.edit and Device.halt (added for the base): in-place changes keep the queued end right;
-a halt discards everything at once and rests where it is told."""
+"""The executor without ROS: Device.edit and Device.halt (in-place changes keep the queued end
+right; a halt discards everything at once and rests where it is told), sequences queued whole,
+what was discarded, and step listeners at their rates."""
 from dataclasses import dataclass
 
-from acti_motion.executor import Device, DiscardLog
+import numpy as np
+
+from acti_motion.executor import Device, DiscardLog, MotionExecutor
+from acti_sim.world import World
 
 
 @dataclass
@@ -94,3 +98,19 @@ def test_a_discarded_motion_stays_discarded_after_many_more_discards():
     assert d.discard_reason(first) == DiscardLog.FORGOTTEN and d.was_discarded(first)
     assert not d.was_discarded(done) and d.discard_reason(d.last_id) == "servo off"
     assert not d.was_discarded(d.last_id + 1) and not d.was_discarded(10 ** 9)
+
+
+def test_a_listener_keeps_a_rate_that_is_no_whole_number_of_steps():
+    """100 Hz at 250 Hz is every 2.5 steps: it alternates 2 and 3 (rounding to 2 gave 125 Hz)."""
+    world = World(time_step=0.004)
+    try:
+        ex, calls = MotionExecutor(world, real_time_factor=0.0), []
+        ex.after_step(lambda w: calls.append(ex.steps), every=ex.steps_per_period(100.0))
+        ex.after_step(lambda w: calls.append(-ex.steps), every=ex.steps_per_period(50.0))
+        for _ in range(250):
+            ex.step()
+    finally:
+        world.close()
+    fractional = np.array([c for c in calls if c > 0])
+    assert len(fractional) == 100 and set(np.diff(fractional).tolist()) == {2, 3}
+    assert [-c for c in calls if c < 0] == list(range(5, 251, 5))

@@ -132,8 +132,7 @@ class SimCamera:
         self._stamp: Any = None                 # of the frame being rendered; None: idle
         threading.Thread(target=self._publish_frames, name="acti-camera-publish",
                          daemon=True).start()
-        rate = 1.0 / executor.dt
-        executor.after_step(self._ask, every=max(1, round(rate / c.camera_rate_hz)))
+        executor.after_step(self._ask, every=executor.steps_per_period(c.camera_rate_hz))
 
     def _ask(self, world: World) -> None:
         """Simulation thread: hand the renderer this instant, unless it is still busy (or gone)."""
