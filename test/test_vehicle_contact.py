@@ -99,3 +99,19 @@ def test_a_contact_while_another_thread_plans_a_move_does_not_deadlock(base, exe
     assert not simulation.is_alive() and not service.is_alive(), "deadlock"
     assert not out["move"].ok and "Locked" in out["move"].comment
     assert state(base) == VehicleState.LOCKED
+
+
+def test_enabling_the_sensor_while_the_bumper_touches_locks_the_base(base, executor, wall):  # noqa: F811
+    """有効時に接触を検出すると…停止し: armed only once the bumper came free, a base enabled
+    against a box pushed it 590 mm with the sensor on and no alarm."""
+    ready(base)
+    base.set_velocity((200.0, 45.0))
+    base.move_forward(1000.0)
+    run_until(executor, lambda: state(base) == VehicleState.STUCK, 8.0)
+    settle(executor, base, 2.0)
+    assert base.get_input(1).values["input"] == 1                          # touching
+    assert base.set_digital_sensor_lock(True).ok
+    run_until(executor, lambda: state(base) == VehicleState.LOCKED, 0.1)
+    assert base.unlock().ok and base.move_forward(-200.0).ok               # backs away unlocked
+    settle(executor, base)
+    assert state(base) == VehicleState.READY

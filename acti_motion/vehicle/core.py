@@ -211,8 +211,11 @@ class VehicleCore(Sensing):
 
     @command
     def set_digital_sensor_lock(self, on_off: bool) -> None:
+        """Enabled, the sensor is armed at once: a bumper already touching something locks the
+        base (有効時に接触を検出すると…停止し); only `unlock` waits for the bumper to come free,
+        so that the base can back away."""
         self.digital_sensor_lock = bool(on_off)
-        self._contact_armed = not self._contact
+        self._contact_armed = True
 
     # --- versions, limits, settings ---------------------------------------------------------
     @query
