@@ -106,6 +106,26 @@ def test_joystick_drives_within_the_settings_and_off_brakes_to_ready(base, execu
     assert not base.joy_input([0.0, 1.0], [])
 
 
+def test_joystick_off_brakes_its_drive_with_a_move_queued_behind(base, executor):  # noqa: F811
+    """常に真を返します; 減速停止後に Ready: it answered false ("busy with other moves") and the
+    drive went on to its deadman."""
+    ready(base)
+    assert base.set_joystick(True).ok
+    base.set_velocity((300.0, 30.0))
+    for _ in range(10):
+        assert base.joy_input([0.0, 1.0], [])
+        steps(executor, 0.05)
+    x, y, th = base.get_position().values["pos"]
+    assert base.move_linear_abs((x + 500.0, y, th)).ok     # queued behind the joystick drive
+    v0 = base.odometry.v
+    assert base.set_joystick(False).ok
+    took = run_until(executor, lambda: abs(base.odometry.v) < 0.005, 1.0)
+    assert took < v0 / 1.0 + 0.1                           # at the maximum acceleration
+    settle(executor, base, 5.0)               # … then Ready: the move planned from the drive's
+    assert state(base) == VehicleState.READY   # old end is discarded, and says why
+    assert base.device.discard_reason(base.device.last_id) == "the joystick was switched off"
+
+
 def test_joystick_is_ignored_while_moves_are_queued(base):
     ready(base)
     base.set_joystick(True)

@@ -526,7 +526,7 @@ class VehicleCore(Sensing):
             c = self.config
             self._drive((0.0, 0.0), 0.0, (c.accel_limit_translation / 1000.0,
                                           math.radians(c.accel_limit_rotation)), "joystick",
-                        take_over=False)
+                        take_over=False, brake=True)
 
     def joy_input(self, axes: list[float], buttons: list[int]) -> bool:
         """A sensor_msgs/Joy sample (not an IDL operation): full stick = the velocity setting.
@@ -634,15 +634,17 @@ class VehicleCore(Sensing):
             device.discard_queue("replaced by a newer move before it started")
             self._op_generation = device.generation     # this operation's own discard
 
-    def _take_over(self, device: Device, cur: Any, t: float, path: Path, label: str) -> Any:
+    def _take_over(self, device: Device, cur: Any, t: float, path: Path, label: str,
+                   why: str = "") -> Any:
         """Commit: the running motion follows `path` from motion time t as a `label` motion;
-        what was queued behind it was planned from its old end and is discarded. A move taken
-        over never reaches its goal: it retires as discarded and the motion runs on under a
-        new id; a jog (or the joystick) updating itself keeps its id."""
+        what was queued behind it was planned from its old end and is discarded (`why`, else
+        "taken over by <label>"). A move taken over never reaches its goal: it retires as
+        discarded and the motion runs on under a new id; a jog (or the joystick) updating itself
+        keeps its id."""
         if device.t > t:
             return STALE
         self._admit(SERVO_ON, label, device)
-        device.discard_queue(f"taken over by {label}")
+        device.discard_queue(why or f"taken over by {label}")
         self._op_generation = device.generation         # this operation's own discard
         if not (label == cur.label and label in VELOCITY_DRIVEN):
             device.renumber(cur, f"taken over by {label}")
@@ -673,16 +675,18 @@ class VehicleCore(Sensing):
         return {"motion_id": motion_id}
 
     def _drive(self, target: tuple[float, float], hold: float, accel: tuple[float, float],
-               label: str, take_over: bool) -> dict:
+               label: str, take_over: bool, brake: bool = False) -> dict:
         """Velocity drive: re-plan the running jog/joystick motion from its reference a little
         ahead of now (speed continuous), take over another running move (`take_over`, else
         refused), or start one on an idle base. The deadman ends it `hold` s of wall time from
-        now unless called again."""
+        now unless called again. A `brake` of the running drive goes in whatever is queued
+        behind it, and discards that (planned from the drive's old end; the base goes Ready)."""
         def look(device: Device, attempt: int):
             if device.paused:
                 raise VehicleRefused(AlarmCode.WRONG_STATE, PAUSED_DRIVE.format(label))
             cur = self._running(device)
-            if not take_over and (device.queue or cur is not None and cur.label not in VELOCITY_DRIVEN):
+            if not take_over and (device.queue and not brake
+                                  or cur is not None and cur.label not in VELOCITY_DRIVEN):
                 raise self._busy(label)
             return None if cur is None else (cur, self._splice_time(device, cur.motion, attempt))
 
@@ -694,7 +698,8 @@ class VehicleCore(Sensing):
             path = velocity_path(motion.at(t), *motion.reference_twist(t), target, hold, accel)
 
             def commit(device: Device) -> Any:
-                out = self._take_over(device, cur, t, path, label)
+                out = self._take_over(device, cur, t, path, label,
+                                      "the joystick was switched off" if brake else "")
                 if out is not STALE:
                     self._arm_deadman(hold, target)
                 return out
