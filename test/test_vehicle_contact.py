@@ -60,6 +60,10 @@ def test_contact_with_the_sensor_off_is_a_blockage(base, executor, wall):  # noq
     settle(executor, base, 2.0)
     steps(executor, 0.3)
     assert abs(base.odometry.v) < 5e-3
+    assert base.stop().ok and state(base) == VehicleState.READY           # 停止後は…待機状態に
+    base.move_forward(500.0)
+    run_until(executor, lambda: state(base) == VehicleState.STUCK, 8.0)
+    settle(executor, base, 2.0)
     assert base.move_forward(-300.0).ok and state(base) == VehicleState.BUSY   # moving on clears it
     settle(executor, base)
     assert state(base) == VehicleState.READY and base.get_input(1).values["input"] == 0

@@ -336,8 +336,9 @@ class VehicleCore(Sensing):
     @command
     def stop(self) -> None:
         """Decelerate at the maximum acceleration and discard every motion, also those given
-        until the base is at rest."""
+        until the base is at rest; then Ready (停止後は…待機状態に移行): Stuck ends too."""
         self._stop()
+        self._accepted_motion()
 
     # --- motion -----------------------------------------------------------------------------
     @planned
