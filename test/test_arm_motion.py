@@ -378,3 +378,27 @@ def test_offsets_apply_to_cp_targets_and_feedback(arm, executor):  # noqa: F811
     got, _ = feedback(arm)
     assert max(deviation) <= 0.5
     assert position_error_mm(got, target) <= 0.1 and orientation_error_deg(got, target) <= 0.05
+
+
+@pytest.mark.parametrize("limit", ["joint", "cartesian"])
+def test_a_move_queued_before_a_limit_changed_stops_where_it_is_outside_it(arm, executor, limit):  # noqa: F811
+    """5.4.8 範囲を超える場合は停止してアラーム: a move accepted before the limit was set, and
+    starting outside it, ran to its end with no alarm (only crossings were watched)."""
+    P0, _ = feedback(arm)
+    assert arm.move_linear_cartesian_rel(rel(dx=200.0)).ok        # accepted, not yet started
+    assert arm.pause().ok                                         # … and held: not moving
+    if limit == "joint":
+        j1 = arm.get_feedback_pos_joint().values["pos"][0]
+        limits = arm.get_soft_limit_joint().values["soft_limit"]
+        limits[0] = (170.0, j1 + 0.5)                             # J1 already below its lower
+        assert arm.set_soft_limit_joint(limits).ok                # paused is not moving
+    else:
+        x0 = P0[0, 3] * 1000.0
+        assert arm.set_soft_limit_cartesian((x0 - 50.0, -1000.0), (1000.0, -1000.0),
+                                            (1600.0, -100.0)).ok
+    assert arm.resume().ok
+    run_until(executor, lambda: arm.alarms, 1.0)
+    assert [a.code for a in arm.alarms] == [0x4 if limit == "joint" else 0x5]
+    run_until(executor, lambda: not arm.device.busy, 2.0)
+    P1, _ = feedback(arm)
+    assert np.linalg.norm(P1[:3, 3] - P0[:3, 3]) * 1000.0 < 20.0  # stopped at once, not 200 mm on

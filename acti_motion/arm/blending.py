@@ -45,6 +45,7 @@ class Truncated:
         self.unblended = whole
         self.duration = duration
         self.ramp, self.kind = whole.ramp, whole.kind
+        self.limits_checked = whole.limits_checked
 
     def at(self, t: float) -> ArmSetpoint:
         return self.unblended.at(min(t, self.duration))
@@ -67,6 +68,7 @@ class Blend:
         self.duration = nxt.duration
         self.ramp = max(prev.ramp, nxt.ramp)
         self.kind = nxt.kind
+        self.limits_checked = min(prev.limits_checked, nxt.limits_checked)
 
     def at(self, t: float) -> ArmSetpoint:
         b = self.next.at(t)

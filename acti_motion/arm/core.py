@@ -227,14 +227,15 @@ class ArmCore:
         self.min_accel_time_joint = self.accel_time_joint = MAX_ACCEL_TIME_S
         self.min_accel_time_cartesian = self.accel_time_cartesian = MAX_ACCEL_TIME_S
         self.frames = Frames()
-        self._apply_settings(c)
-        self.servo = False
-        self._alarms: list[Alarm] = []
-        self._alarm_lock = threading.Lock()
+        self._limits_revision = 0      # one more at every setting of a soft limit
         self._feedback = world.arm_positions()
         self._finger = world.gripper_position()
         self.device = executor.add_device("arm", c.queue_size,
                                           ArmSetpoint(q0.copy(), self._finger))
+        self._apply_settings(c)
+        self.servo = False
+        self._alarms: list[Alarm] = []
+        self._alarm_lock = threading.Lock()
         self._inside: np.ndarray | None = None
         self._batch = threading.local()               # the moves an `all_or_nothing` collects
         self._cartesian_memo: tuple | None = None     # (joints sample, frames, its pose)
@@ -271,8 +272,12 @@ class ArmCore:
         self._watch()
 
     def _watch(self) -> None:
-        """Stop and raise an alarm when the commanded set-point leaves a soft limit while moving
-        (possible when the limits changed after the motion was accepted).
+        """Stop and raise an alarm when the commanded set-point exceeds a soft limit while
+        moving (5.4.8: 範囲を超える場合は、動作を停止してアラーム). A motion checked against the
+        limits in force can only leave them by a crossing, and one that starts outside them (a
+        move back inside) may move; one accepted before the limits changed is stopped wherever
+        it is outside them, also from its first step (it ran on outside a limit set while it
+        waited in the queue).
 
         At rest nothing is computed (the FK is most of a step's Python work): the first moving
         step compares against the rest point, under the limits in force then."""
@@ -287,7 +292,8 @@ class ArmCore:
         was, self._inside = self._inside, inside
         if self._alarms:
             return
-        left = np.flatnonzero(was & ~inside)
+        stale = getattr(cur.motion, "limits_checked", None) != self._limits_revision
+        left = np.flatnonzero(~inside if stale else was & ~inside)
         if not len(left):
             return
         i = int(left[0])
@@ -382,6 +388,7 @@ class ArmCore:
                                   f"hardware range [{hlo:.3f}, {hhi:.3f}]°")
             limits[i] = lower, upper
         self.soft_limit_joint = limits
+        self._limits_revision += 1
 
     # === middle-level port: getters ==============================================================
     @returns(*GETTER)
@@ -497,6 +504,7 @@ class ArmCore:
                                   f"within ±{SOFT_LIMIT_CARTESIAN_MM:g} mm")
             limits[i] = lower, upper
         self.soft_limit_cartesian = limits
+        self._limits_revision += 1
 
     @returns(*SETTER)
     def set_soft_limit_box(self, box: tuple[float, ...]) -> Reply:
@@ -517,12 +525,8 @@ class ArmCore:
         is queued: their targets were given in the present robot frame, and a queued move ended
         100 mm from where the new frame said it should."""
         base = _offset(offset, BASE_OFFSET_MM, ReturnCode.VALUE_ERR)
-        with self.device.idle_for_settings() as idle:
-            if not idle:
-                raise Refused(R.NG, "set_base_offset is refused while a motion is planned, "
-                                    "running, paused or queued: its target is in the present "
-                                    "robot frame (wait or stop first)")
-            self.frames = Frames(base, self.frames.tool)
+        self._set_while_idle("set_base_offset", R.NG, "its target is in the present robot frame",
+                             lambda: setattr(self, "frames", Frames(base, self.frames.tool)))
 
     @returns(R.STATUS_ERR)
     def set_control_point_offset(self, offset: list[float]) -> None:
@@ -530,12 +534,20 @@ class ArmCore:
         planned with the present control point (5.4.23: not while moving)."""
         self._check_idle("set_control_point_offset")
         tool = _offset(offset, CONTROL_POINT_OFFSET_MM, ReturnCode.NG)
+        self._set_while_idle("set_control_point_offset", R.STATUS_ERR,
+                             "it was planned for the present control point",
+                             lambda: setattr(self, "frames", Frames(self.frames.base, tool)))
+
+    def _set_while_idle(self, name: str, code: ReturnCode, why: str,
+                        apply: Callable[[], None]) -> None:
+        """apply() unless a motion is planned, runs, is paused or is queued (then `code`, saying
+        `why`): what was accepted was planned and checked with the settings in force, and would
+        run on under new ones. Decided under the device's accept lock, which it never waits for."""
         with self.device.idle_for_settings() as idle:
             if not idle:
-                raise Refused(R.STATUS_ERR, "set_control_point_offset is refused while a motion "
-                                            "is planned, running, paused or queued (wait or stop "
-                                            "first)")
-            self.frames = Frames(self.frames.base, tool)
+                raise Refused(code, f"{name} is refused while a motion is planned, running, "
+                                    f"paused or queued: {why} (wait or stop first)")
+            apply()
 
     @returns(*SETTER)
     def set_home(self, joint_point: list[float]) -> None:
@@ -995,6 +1007,7 @@ class ArmCore:
             servo_off (or an alarm) that came while this request waited for another's plan
             stopped an idle arm, and the move would have been queued behind it."""
             self._check_can_move()
+            limits = self._limits_revision
             try:
                 motion = plan(start)
             except Refused:
@@ -1006,6 +1019,7 @@ class ArmCore:
                     from None
             if not math.isfinite(motion.duration):
                 raise value_error(f"{label}: the move would take forever at these settings")
+            motion.limits_checked = limits
             return motion
         return guarded
 
