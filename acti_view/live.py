@@ -71,6 +71,7 @@ class LiveView:
         self.path: deque[np.ndarray] = deque(maxlen=trail_points)
         self._lines: dict[str, Any] = {}          # the trails' scene nodes
         self._watched = False
+        self._restarted_at = -1                   # the sampler's count when the trails restarted
         self.frames = 0
         self._panel_text = ""
         self._shown_targets: tuple = ()
@@ -125,8 +126,9 @@ class LiveView:
             deadline = max(deadline + self.period, time.monotonic() - self.period)
             if self._stop.wait(max(0.0, deadline - time.monotonic())):
                 return
-            if not self.watching(bool(self.server.get_clients())):
-                continue                    # nobody looks: costs nothing
+            if not self.watching(bool(self.server.get_clients())) \
+                    or self.reader.sampler.count == self._restarted_at:
+                continue                    # nobody looks (costs nothing), or no fresh sample yet
             try:
                 self.update(self.reader.read())
                 failed = False
@@ -146,6 +148,9 @@ class LiveView:
         return watched
 
     def _restart_trails(self) -> None:
+        """Also waits for a new sample of the world: the last one is from when the last page
+        closed, and its pose would start the trails where the robot was then."""
+        self._restarted_at = self.reader.sampler.count
         self.trail.clear()
         self.path.clear()
         for line in self._lines.values():

@@ -37,11 +37,13 @@ class WorldSampler:
     def __init__(self, executor: MotionExecutor, every: int) -> None:
         self.latest = self._read(executor.world)
         self.active = False
+        self.count = 0                  # samples taken: a new one shows the world is current
         executor.after_step(self._sample, every=every)
 
     def _sample(self, world: World) -> None:
         if self.active:
             self.latest = self._read(world)
+            self.count += 1
 
     @staticmethod
     def _read(world: World) -> WorldSample:

@@ -402,3 +402,19 @@ def test_a_move_queued_before_a_limit_changed_stops_where_it_is_outside_it(arm, 
     run_until(executor, lambda: not arm.device.busy, 2.0)
     P1, _ = feedback(arm)
     assert np.linalg.norm(P1[:3, 3] - P0[:3, 3]) * 1000.0 < 20.0  # stopped at once, not 200 mm on
+
+
+def test_setting_limits_again_does_not_stop_a_move_back_inside(arm, executor):  # noqa: F811
+    """A move back inside a limit may run; re-sending the same limits, or changing another
+    axis's, while it runs stopped it with the alarm (every setting counted as a change)."""
+    P0, _ = feedback(arm)
+    z0 = P0[2, 3] * 1000.0
+    box = ((1000.0, -1000.0), (1000.0, -1000.0), (z0 - 40.0, -100.0))
+    assert arm.set_soft_limit_cartesian(*box).ok                   # the arm 40 mm above it
+    assert arm.move_linear_cartesian_rel(rel(dz=-80.0)).ok         # back inside: allowed
+    run_until(executor, lambda: arm.device.current is not None, 0.1)
+    assert arm.set_soft_limit_cartesian(*box).ok                   # the same again
+    wider_x = ((1100.0, -1000.0),) + box[1:]
+    assert arm.set_soft_limit_cartesian(*wider_x).ok               # another axis's
+    run_until(executor, lambda: not arm.device.busy, 5.0)
+    assert not arm.alarms, arm.alarms

@@ -119,3 +119,18 @@ def test_enabling_the_sensor_while_the_bumper_touches_locks_the_base(base, execu
     assert base.unlock().ok and base.move_forward(-200.0).ok               # backs away unlocked
     settle(executor, base)
     assert state(base) == VehicleState.READY
+
+
+def test_switching_the_sensor_on_again_while_locked_lets_the_base_back_away(base, executor, wall):  # noqa: F811
+    """A client re-sending its "sensor on" re-armed it against the obstacle: unlock locked again
+    at the next step, and the base could not back away."""
+    ready(base)
+    base.set_velocity((200.0, 45.0))
+    assert base.set_digital_sensor_lock(True).ok
+    base.move_forward(1000.0)
+    run_until(executor, lambda: state(base) == VehicleState.LOCKED, 5.0)
+    settle(executor, base, 2.0)
+    assert base.set_digital_sensor_lock(True).ok
+    assert base.unlock().ok
+    steps(executor, 0.1)
+    assert state(base) == VehicleState.READY and base.move_forward(-200.0).ok

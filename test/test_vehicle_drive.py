@@ -148,3 +148,27 @@ def test_a_zero_jog_brakes_a_running_jog(base, executor):  # noqa: F811
     assert base.move_jog(0.0, 0.0, 0.0).values["motion_id"] == 1
     took = run_until(executor, lambda: abs(base.odometry.v) < 0.005, 2.0)
     assert took == pytest.approx(0.3 / 0.5, abs=0.1)            # at the acceleration setting
+
+
+def test_joystick_off_as_its_drive_ends_is_still_true(base, executor):  # noqa: F811
+    """The drive retired (its deadman) and the queued move started between set_joystick's look
+    and its brake: it answered false ("busy") though the joystick was off."""
+    ready(base)
+    assert base.set_joystick(True).ok
+    for _ in range(10):
+        assert base.joy_input([0.0, 0.5], [])
+        steps(executor, 0.05)
+    x, y, th = base.get_position().values["pos"]
+    assert base.move_linear_abs((x + 300.0, y, th)).ok
+    edit_planned, once = base.device.edit_planned, []
+
+    def drive_ends_first(look, plan, tries=6):
+        if not once:
+            once.append(1)
+            base._drive_deadline = 0.0                  # the deadman fires here
+            run_until(executor, lambda: base.device.current is not None
+                      and base.device.current.label != "joystick", 3.0)
+        return edit_planned(look, plan, tries)
+    base.device.edit_planned = drive_ends_first
+    r = base.set_joystick(False)
+    assert r.ok and not base.joystick and not base.alarms.active(), r.comment

@@ -149,7 +149,12 @@ def test_trails_restart_when_a_page_opens_after_nobody_looked(robot):
             view.update(reader.read())
         assert len(view.trail) > 5 and view._lines
         assert not view.watching(False)
+        for _ in range(50):
+            executor.step()                           # moves on, unsampled
         assert view.watching(True) and not view.trail and not view.path and not view._lines
+        assert view._restarted_at == reader.sampler.count    # waits for a fresh sample …
+        executor.step()
+        assert reader.sampler.count > view._restarted_at     # … which the next step takes
         view.update(reader.read())
         assert len(view.trail) == 1
     finally:

@@ -68,7 +68,8 @@ class Blend:
         self.duration = nxt.duration
         self.ramp = max(prev.ramp, nxt.ramp)
         self.kind = nxt.kind
-        self.limits_checked = min(prev.limits_checked, nxt.limits_checked)
+        a, b = prev.limits_checked, nxt.limits_checked      # both the same, or none known
+        self.limits_checked = a if a is not None and b is not None and np.array_equal(a, b) else None
 
     def at(self, t: float) -> ArmSetpoint:
         b = self.next.at(t)

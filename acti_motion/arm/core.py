@@ -227,7 +227,6 @@ class ArmCore:
         self.min_accel_time_joint = self.accel_time_joint = MAX_ACCEL_TIME_S
         self.min_accel_time_cartesian = self.accel_time_cartesian = MAX_ACCEL_TIME_S
         self.frames = Frames()
-        self._limits_revision = 0      # one more at every setting of a soft limit
         self._feedback = world.arm_positions()
         self._finger = world.gripper_position()
         self.device = executor.add_device("arm", c.queue_size,
@@ -273,11 +272,11 @@ class ArmCore:
 
     def _watch(self) -> None:
         """Stop and raise an alarm when the commanded set-point exceeds a soft limit while
-        moving (5.4.8: 範囲を超える場合は、動作を停止してアラーム). A motion checked against the
-        limits in force can only leave them by a crossing, and one that starts outside them (a
-        move back inside) may move; one accepted before the limits changed is stopped wherever
-        it is outside them, also from its first step (it ran on outside a limit set while it
-        waited in the queue).
+        moving (5.4.8: 範囲を超える場合は、動作を停止してアラーム). Against the limits its plan was
+        checked with, a motion can only leave them by a crossing, and one that starts outside
+        them (a move back inside) may move; against a limit that changed since, it is stopped
+        wherever it is outside it, also from its first step (it ran on outside a limit set while
+        it waited in the queue).
 
         At rest nothing is computed (the FK is most of a step's Python work): the first moving
         step compares against the rest point, under the limits in force then."""
@@ -292,8 +291,10 @@ class ArmCore:
         was, self._inside = self._inside, inside
         if self._alarms:
             return
-        stale = getattr(cur.motion, "limits_checked", None) != self._limits_revision
-        left = np.flatnonzero(~inside if stale else was & ~inside)
+        checked = getattr(cur.motion, "limits_checked", None)
+        changed = (np.ones(len(inside), bool) if checked is None
+                   else np.any(checked != self._limit_rows(), axis=1))
+        left = np.flatnonzero(~inside & (was | changed))
         if not len(left):
             return
         i = int(left[0])
@@ -311,6 +312,10 @@ class ArmCore:
         with self._alarm_lock:
             self._alarms.append(alarm)
         self.stop_motion(fastest=True, reason=f"alarm 0x{alarm.code:X} ({alarm.description})")
+
+    def _limit_rows(self) -> np.ndarray:
+        """The soft limits as rows (lower, upper): J1 … J7 (degree), then x, y, z (mm)."""
+        return np.concatenate([self.soft_limit_joint, self.soft_limit_cartesian])
 
     def _within_watch_limits(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Joint values (degree) and control-point position (mm) of set-point q, and which of
@@ -388,7 +393,6 @@ class ArmCore:
                                   f"hardware range [{hlo:.3f}, {hhi:.3f}]°")
             limits[i] = lower, upper
         self.soft_limit_joint = limits
-        self._limits_revision += 1
 
     # === middle-level port: getters ==============================================================
     @returns(*GETTER)
@@ -504,7 +508,6 @@ class ArmCore:
                                   f"within ±{SOFT_LIMIT_CARTESIAN_MM:g} mm")
             limits[i] = lower, upper
         self.soft_limit_cartesian = limits
-        self._limits_revision += 1
 
     @returns(*SETTER)
     def set_soft_limit_box(self, box: tuple[float, ...]) -> Reply:
@@ -1007,7 +1010,7 @@ class ArmCore:
             servo_off (or an alarm) that came while this request waited for another's plan
             stopped an idle arm, and the move would have been queued behind it."""
             self._check_can_move()
-            limits = self._limits_revision
+            limits = self._limit_rows()
             try:
                 motion = plan(start)
             except Refused:

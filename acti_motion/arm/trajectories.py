@@ -157,7 +157,7 @@ class ArmMotion:
         self.path, self.timing, self.ramp, self.kind = path, timing, ramp, kind
         self.finger0, self.dfinger = finger0, finger1 - finger0
         self.duration = timing.duration
-        self.limits_checked = -1      # the soft limits' revision its plan was checked against
+        self.limits_checked: np.ndarray | None = None   # the soft limits its plan was checked with
 
     def at(self, t: float) -> ArmSetpoint:
         s, _ = self.timing.sample(t)

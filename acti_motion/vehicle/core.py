@@ -211,11 +211,14 @@ class VehicleCore(Sensing):
 
     @command
     def set_digital_sensor_lock(self, on_off: bool) -> None:
-        """Enabled, the sensor is armed at once: a bumper already touching something locks the
-        base (有効時に接触を検出すると…停止し); only `unlock` waits for the bumper to come free,
-        so that the base can back away."""
+        """Switched on, the sensor is armed at once: a bumper already touching something locks
+        the base (有効時に接触を検出すると…停止し). Once it has locked, it re-arms only when the
+        bumper is free, however often it is switched on again, so that an unlocked base can
+        back away."""
+        switched_on = bool(on_off) and not self.digital_sensor_lock
         self.digital_sensor_lock = bool(on_off)
-        self._contact_armed = True
+        if switched_on and not self.locked:
+            self._contact_armed = True
 
     # --- versions, limits, settings ---------------------------------------------------------
     @query
@@ -686,6 +689,8 @@ class VehicleCore(Sensing):
             if device.paused:
                 raise VehicleRefused(AlarmCode.WRONG_STATE, PAUSED_DRIVE.format(label))
             cur = self._running(device)
+            if brake and (cur is None or cur.label != label):
+                return None                         # the drive is over already: nothing to brake
             if not take_over and (device.queue and not brake
                                   or cur is not None and cur.label not in VELOCITY_DRIVEN):
                 raise self._busy(label)

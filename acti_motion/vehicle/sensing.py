@@ -34,15 +34,19 @@ class Sensing:
         self._contact = contact = world.bumper_in_contact()
         if not contact:
             self._contact_armed = True
-        elif self.digital_sensor_lock and self._contact_armed and not self.locked:
+        elif self._contact_trips():
             with self.lock:
-                self._contact_armed = False
-                self.locked = True
-                self.alarms.raise_(AlarmCode.CONTACT, "contact sensor: the bumper touched something",
-                                   Kind.CONTACT)
-                self._halt("a contact (the base is Locked)")
+                if self._contact_trips():       # again under the lock: not switched off meanwhile
+                    self._contact_armed = False
+                    self.locked = True
+                    self.alarms.raise_(AlarmCode.CONTACT,
+                                       "contact sensor: the bumper touched something", Kind.CONTACT)
+                    self._halt("a contact (the base is Locked)")
         self._watch_tracking(world.time)
         self._watch_deadman()
+
+    def _contact_trips(self) -> bool:
+        return self.digital_sensor_lock and self._contact_armed and not self.locked
 
     def _watch_deadman(self) -> None:
         """A jog or joystick drive not renewed within its timeout (wall time, so a pause does
