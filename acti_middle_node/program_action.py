@@ -71,14 +71,8 @@ class ProgramAction:
     async def _run(self, goal_handle: Any) -> RunProgram.Result:
         goal = goal_handle.request
         program = bytes(goal.code) if len(goal.code) else goal.text
-        try:
-            run = ProgramRun(self.core, program, io=self.io, defaults=self.defaults,
-                             budget=goal.budget or None)
-        except StrolicError as error:
-            goal_handle.abort()
-            return RunProgram.Result(status=Status.INVALID, exception=error.report(),
-                                     exception_kind=error.kind.value,
-                                     exception_offset=_offset(error))
+        run = ProgramRun(self.core, program, io=self.io, defaults=self.defaults,
+                         budget=goal.budget or None)       # loaded on the run's thread
         self._current = run
         run.start()
         # the run's end pokes the watch from a thread that only waits for it

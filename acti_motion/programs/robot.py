@@ -51,6 +51,8 @@ FLAG_HAND = 5           # the hand is not defined, or too many hands
 STATUS_DISCARDED = -1
 STATUS_ALARM = -2
 
+CONSOLE_LINE = 4096            # characters of a console line kept for the result …
+CONSOLE_BYTES = 1 << 20        # … and of all of them
 POLL = 1.0 / 120.0             # s (simulated) between two looks of a waiting function
 REST_POLL_S = 0.002            # s (wall) between two looks at a stopping arm
 REST_TIMEOUT_S = 60.0          # s (wall): the longest stop (10 s accel time) at real-time factor ⅙
@@ -178,6 +180,8 @@ class RobotHost(Host):
         self.step = step
         self.echo = echo
         self.lines: list[str] = []
+        self.lines_dropped = 0
+        self._console_size = 0
         self.jspeed = d.program_jspeed
         self.speed = min(d.program_speed, arm.max_speed_cartesian[0])   # what SPEED would take
         self.accel: tuple[str, float] | None = None     # ("percent" | "time", value)
@@ -205,7 +209,16 @@ class RobotHost(Host):
         return method(self, vm, proc)
 
     def console(self, text: str) -> None:
-        self.lines.append(text)
+        """A console line (TRACE, warnings, flags, PAUSE messages), kept for the run's result:
+        at most CONSOLE_LINE characters each and CONSOLE_BYTES in all; lines beyond are only
+        counted (a traced 4 MiB string, ten times, put 168 MB into the result)."""
+        if len(text) > CONSOLE_LINE:
+            text = f"{text[:CONSOLE_LINE]}… ({len(text)} characters)"
+        if self._console_size + len(text) > CONSOLE_BYTES:
+            self.lines_dropped += 1
+        else:
+            self.lines.append(text)
+            self._console_size += len(text)
         if self.echo:
             print(text, file=sys.stderr)
 
@@ -631,6 +644,7 @@ class RobotHost(Host):
         message = pop_of(proc, Str, "a message (St)").data.decode("utf-8", "replace")
         self.console(f"PAUSE: {message}")
         arm = self.arm
+        generation = arm.device.generation          # a stop (servo off, an alarm) changes it
         arm.device.pause(arm.current_ramp())
         self.state, self.message = "paused", message
         started = self.now()
@@ -642,6 +656,11 @@ class RobotHost(Host):
             self._frozen += self.now() - started
             self._last_check = self.now()
             self.state, self.message = "running", ""
+        if arm.device.generation != generation or not arm.servo or arm.alarms:
+            # the pause ended by a stop, not a resume: the program must not go on moving
+            raise fail(K.SERVO_ERROR if not arm.servo else K.ROBOT_ERROR,
+                       "the arm was stopped while the program was paused (stop, servo off or "
+                       "an alarm; only resume goes on)")
         _push_flag(proc, 0)
 
     def delay(self, vm, proc):

@@ -57,10 +57,33 @@ class ProgramResult:
         return self.error.report() if self.error is not None else ""
 
 
+MAX_PROGRAM = 1 << 20      # bytes (code) or characters (text) of a program
+RESULT_ITEM = 65536        # bytes of a stack item's data shown in the result …
+RESULT_ITEMS = 1000        # … and the top-most stack items shown
+
+
 def load(program: bytes | str) -> list:
     """Decoded codes of a program in the text form (str) or as code (bytes); StrolicError when
-    it does not assemble or decode."""
+    it does not assemble or decode, or is longer than MAX_PROGRAM (a 2 MB text takes seconds
+    to assemble)."""
+    if len(program) > MAX_PROGRAM:
+        raise StrolicError(K.INVALID_CODE, f"the program is {len(program)} "
+                           f"{'characters' if isinstance(program, str) else 'bytes'} long: at most "
+                           f"{MAX_PROGRAM} (1 MiB)")
     return decode(assemble(program) if isinstance(program, str) else bytes(program))
+
+
+def shown_stack(stack: list) -> list[str]:
+    """The final stack in the text form, bottom first: its top RESULT_ITEMS items, each whose
+    data is longer than RESULT_ITEM bytes by its size only (DUP shares a datum, so 13 copies of
+    an 8 MB string made 436 MB of result text)."""
+    shown = [f"… {len(stack) - RESULT_ITEMS} items below not shown"] \
+        if len(stack) > RESULT_ITEMS else []
+    for item in stack[-RESULT_ITEMS:]:
+        data = getattr(item, "data", None) or getattr(item, "body", b"")
+        shown.append(f"{type(item).__name__}<{len(data)} bytes, not shown>"
+                     if len(data) > RESULT_ITEM else format_value(item))
+    return shown
 
 
 class ProgramRun:
@@ -70,7 +93,7 @@ class ProgramRun:
                  step=None, defaults: ProgramDefaults | None = None, budget: int | None = None,
                  echo: bool = False) -> None:
         self.arm = arm
-        self.codes = load(program)
+        self.program = program
         self.host = RobotHost(arm, io, step=step, defaults=defaults, echo=echo)
         self.vm = VM(self.host)
         self.budget = budget
@@ -78,12 +101,19 @@ class ProgramRun:
         self._thread: threading.Thread | None = None
 
     def run(self) -> ProgramResult:
-        """Run to the end on this thread."""
+        """Load and run to the end on this thread (loading a big program takes a while: not on
+        the caller's, which may serve others)."""
         vm, host = self.vm, self.host
         start = host.now()
         try:
+            codes = load(self.program)
+        except StrolicError as e:
+            host.state = "invalid"
+            self.result = ProgramResult(Status.INVALID, e)
+            return self.result
+        try:
             try:
-                vm.run(self.codes, budget=self.budget)
+                vm.run(codes, budget=self.budget)
                 host.wait_motions(vm)
             except StrolicError:
                 raise
@@ -97,10 +127,12 @@ class ProgramRun:
             status = Status.CANCELED if e.kind is K.STOPPED else Status.EXCEPTION
             error = e
         host.state = status.name.lower()
+        dropped = [f"… {host.lines_dropped} more console lines not kept"] \
+            if host.lines_dropped else []
         self.result = ProgramResult(
-            status, error, [format_value(item) for item in vm.main.stack] if vm.main else [],
+            status, error, shown_stack(vm.main.stack) if vm.main else [],
             [" ".join(format_code(code) for code in decode(data)) for data in host.output],
-            list(host.lines), vm.executed, host.now() - start)
+            host.lines + dropped, vm.executed, host.now() - start)
         return self.result
 
     def start(self) -> None:
@@ -115,7 +147,7 @@ class ProgramRun:
         except Exception as e:  # the world went away (shutdown) or a bug: no traceback, a result
             self.result = ProgramResult(
                 Status.EXCEPTION, StrolicError(K.CONTROLLER_ERROR, f"{type(e).__name__}: {e}"),
-                console=list(self.host.lines), instructions=self.vm.executed)
+                console=self.host.lines[:], instructions=self.vm.executed)
 
     def join(self, timeout: float | None = None) -> bool:
         if self._thread is not None:

@@ -348,3 +348,45 @@ def test_a_fault_outside_the_vm_stops_the_program_and_the_arm(arm, executor):  #
     assert result.status is Status.EXCEPTION and result.error.kind is K.CONTROLLER_ERROR
     assert "RuntimeError: a bug" in result.report and run_.host.state == "exception"
     assert not arm.device.busy and abs(np.degrees(arm.feedback_joints[0]) - WORK[0] - 60) > 10
+
+
+@pytest.mark.parametrize("event, kind", [("stop", K.ROBOT_ERROR), ("servo off", K.SERVO_ERROR)])
+def test_a_stop_during_pause_ends_the_program(arm, executor, event, kind):  # noqa: F811
+    """A stop or servo_off ended the pause as a resume would: PAUSE pushed 0 and the program
+    drove the arm on after the operator's stop."""
+    done = {}
+
+    def hook():
+        if "stopped" not in done and arm.device.paused:
+            done["stopped"] = arm.stop() if event == "stop" else arm.servo_off()
+    q0 = arm.feedback_joints.copy()
+    result = run(arm, executor, '"hold" PAUSE DROP Ar[R8 30 0 0 0 0 0 0] IDRIVE -1 $WAIT',
+                 hook=hook)
+    assert done["stopped"].ok
+    assert result.status is Status.EXCEPTION and result.error.kind is kind, result.report
+    assert "PAUSE" in result.report
+    assert np.allclose(arm.feedback_joints, q0, atol=1e-3)           # it did not go on
+
+
+def test_the_result_keeps_its_size_whatever_the_program_holds(arm, executor):  # noqa: F811
+    """13 copies (DUP) of an 8 MB string put 436 MB of text into the result, and a traced
+    4 MiB string, ten times, 168 MB of console lines; the data limit counts neither."""
+    big = ('.name f %1000 .name g %1001 .name i %1002 VAR #f #g #i DCL '
+           '#f FDEF Fn{ "\\x00\\x01\\x02\\x03\\x04\\x05\\x06\\x07" top: DUP CONC DUP LNG 4000000 '
+           'LT >top BRT END } #i 0 STORE TRON '
+           '#g FDEF Fn{ top: DUP TRACE #i i INC STORE i 10 LT >top BRT END } f g ')
+    result = run(arm, executor, big + "DUP " * 12 + "1 2")
+    assert result.status is Status.FINISHED, result.report
+    assert len(result.stack) == 15 and result.stack[-1] == "2"
+    assert result.stack[0] == "Str<4194304 bytes, not shown>"
+    assert sum(map(len, result.console)) < 2 << 20 and len(result.console) > 1
+    result = run(arm, executor, "1 " * 1500)
+    assert result.stack[0] == "… 500 items below not shown" and len(result.stack) == 1001
+
+
+def test_a_program_is_loaded_on_its_own_thread_and_bounded(arm, executor):  # noqa: F811
+    """Loading ran on the caller's thread (the goal plane: a 2 MB text held a ~/move cancel for
+    7 s); a program longer than 1 MiB is INVALID."""
+    program = ProgramRun(arm, "1 DROP " * 200000, step=executor.step)    # not loaded yet
+    result = program.run()
+    assert result.status is Status.INVALID and "at most 1048576" in result.report
