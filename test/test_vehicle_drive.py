@@ -172,3 +172,15 @@ def test_joystick_off_as_its_drive_ends_is_still_true(base, executor):  # noqa: 
     base.device.edit_planned = drive_ends_first
     r = base.set_joystick(False)
     assert r.ok and not base.joystick and not base.alarms.active(), r.comment
+
+
+def test_the_joystick_does_not_take_over_a_jog(base, executor):  # noqa: F811
+    """The joystick drives only an idle base (or its own drive): it took over a running jog
+    (also with its sticks at rest), and the jog ended "taken over by joystick"."""
+    ready(base)
+    assert base.set_joystick(True).ok
+    jog = base.move_jog(-100.0, 0.0, 0.0).values["motion_id"]
+    steps(executor, 0.05)
+    assert not base.joy_input([0.0, 0.5], []) and not base.joy_input([0.0, 0.0], [])
+    run_until(executor, lambda: base.odometry.v < -0.09, 2.0)
+    assert base.device.current.id == jog and not base.device.was_discarded(jog)

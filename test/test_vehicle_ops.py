@@ -405,3 +405,19 @@ def test_start_up_settings_outside_the_limits_are_rejected(executor, config, wor
     with pytest.raises(ValueError, match="vehicle configuration") as refused:
         VehicleCore(executor, VehicleConfig(**config))
     assert words in str(refused.value)
+
+
+@pytest.mark.parametrize("move", [lambda b: b.move_turn(30.0), lambda b: b.move_forward(100.0),
+                                  lambda b: b.move_linear_rel((100.0, 0.0, 0.0)),
+                                  lambda b: b.move_circular_rel((0.0, 500.0), 30.0)])
+def test_a_ready_only_move_during_a_stop_is_true_and_discarded(base, executor, move):  # noqa: F811
+    """停止後は全ての動作指令を廃棄: it was refused as Busy, and the stopped base showed
+    Warning-102."""
+    ready(base)
+    base.move_forward(-600.0)
+    steps(executor, 0.8)
+    assert base.stop().ok
+    r = move(base)
+    assert r.ok and r.comment.startswith("discarded: the base is stopping"), r.comment
+    settle(executor, base, 3.0)
+    assert state(base) == VehicleState.READY

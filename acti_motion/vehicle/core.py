@@ -559,8 +559,14 @@ class VehicleCore(Sensing):
 
     # --- helpers ----------------------------------------------------------------------------
     def _require(self, allowed: tuple[VehicleState, ...], operation: str) -> None:
+        """The state check before planning. A move given while a stop decelerates is true and
+        discarded, as at its commit (`_admit`): a Ready-only one was refused as Busy instead,
+        and left the stopped base in Warning-102."""
         with self.lock:
-            self._refuse_unless(self.state(), allowed, operation)
+            s = self.state()
+            if self.device.stopping and s in SERVO_ON:
+                raise Discarded(operation)
+            self._refuse_unless(s, allowed, operation)
 
     def _admit(self, allowed: tuple[VehicleState, ...], operation: str, device: Device) -> None:
         """The check a planned motion passes when it is committed (after planning): still in
@@ -692,8 +698,8 @@ class VehicleCore(Sensing):
             if brake and (cur is None or cur.label != label):
                 return None                         # the drive is over already: nothing to brake
             if not take_over and (device.queue and not brake
-                                  or cur is not None and cur.label not in VELOCITY_DRIVEN):
-                raise self._busy(label)
+                                  or cur is not None and cur.label != label):
+                raise self._busy(label)         # the joystick drives no further than its own
             return None if cur is None else (cur, self._splice_time(device, cur.motion, attempt))
 
         def plan(seen):
