@@ -76,6 +76,7 @@ TARGET_MM = 1000000.0                    # |x|, |y|, |z| of a Cartesian target o
 ELBOW_DEG = 360.0                        # |elbow| of a Cartesian target (Abs) or turn (Rel)
 REACH_SAMPLES = 64                       # points of a CP path checked against the reach first
 MAX_CHECK_SAMPLES = 20000                # points of a CP path checked against the soft limits
+SERVO_OFF_REASON = "servo off"   # what a wait on a motion servo_off discarded is told
 NEAR_LIMIT_MM = 1.0      # samples this close to a Cartesian soft limit: checked between, finer
 NEAR_LIMIT_DEG = 0.01    # the same for a joint soft limit along a CP path's joint spline
 
@@ -339,7 +340,7 @@ class ArmCore:
         """All axes off; a moving arm stops first (the brakes then hold it where it stopped).
         New motions are refused at once; the state word keeps bit 0x01 until the arm is at rest."""
         self.servo = False
-        self.stop_motion(reason="servo off")
+        self.stop_motion(reason=SERVO_OFF_REASON)
 
     @returns(*GETTER)
     def get_state(self) -> dict:

@@ -25,7 +25,7 @@ from typing import Callable
 
 import numpy as np
 
-from acti_motion.arm.core import ArmCore
+from acti_motion.arm.core import SERVO_OFF_REASON, ArmCore
 from acti_motion.arm.blending import ARM_MOVES, blend_with_previous
 from acti_motion.arm.kinematics import Unreachable, rotate_about
 from acti_motion.arm.poses import compose_relative, hg_to_pose, inverse
@@ -314,8 +314,11 @@ class RobotHost(Host):
         if not lost:
             return None
         self.abnormal = STATUS_DISCARDED
-        why = f"motion {lost[0]} of the program was discarded: {device.discard_reason(lost[0])}"
-        return (K.SERVO_ERROR if not arm.servo else K.ROBOT_ERROR), why
+        reason = device.discard_reason(lost[0])
+        why = f"motion {lost[0]} of the program was discarded: {reason}"
+        # by what discarded it, not by the servo now (a servo_on right after read as a stop)
+        servo_off = reason == SERVO_OFF_REASON or not arm.servo
+        return (K.SERVO_ERROR if servo_off else K.ROBOT_ERROR), why
 
     def motion_status(self) -> int:
         """$DONE: 0 over, 1 the robot moves, 2 only the hand moves, 3 both, < 0 abnormal end."""

@@ -390,3 +390,19 @@ def test_a_program_is_loaded_on_its_own_thread_and_bounded(arm, executor):  # no
     program = ProgramRun(arm, "1 DROP " * 200000, step=executor.step)    # not loaded yet
     result = program.run()
     assert result.status is Status.INVALID and "at most 1048576" in result.report
+
+
+def test_a_servo_off_is_a_servo_error_also_with_the_servo_on_again(arm, executor):  # noqa: F811
+    """The kind came from the servo at the time the program looked: a servo_on right after the
+    servo_off made it "other robot error"."""
+    t0, done = executor.world.time, {}
+
+    def hook():
+        if "off" not in done and executor.world.time - t0 > 0.3:
+            done["off"] = arm.servo_off()
+        elif "off" in done and "on" not in done:
+            done["on"] = arm.servo_on()
+    result = run(arm, executor, "50 JSPEED DROP Ar[R8 40 0 0 0 0 0 0] IDRIVE DROP -1 $WAIT",
+                 hook=hook)
+    assert done["off"].ok and done["on"].ok
+    assert result.status is Status.EXCEPTION and result.error.kind is K.SERVO_ERROR, result.report
