@@ -337,6 +337,15 @@ class Device:
         with self.lock:
             return self._discards.reason(motion_id)
 
+    def doomed(self, motion_id: int) -> str | None:
+        """Why motion `motion_id` is, or will be, discarded: retired so, or accepted while a
+        stop decelerates (it goes when the device rests); None otherwise."""
+        with self.lock:
+            why = self._discards.reason(motion_id)
+            if why is None and self._stop_at is not None and motion_id > self.retired_id:
+                why = self._reason
+            return why
+
     def status(self) -> tuple[int, str, float, int]:
         """(current motion id or 0, its label, its completed fraction, motions queued behind)."""
         cur = self.current

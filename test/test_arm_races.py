@@ -127,13 +127,14 @@ def test_a_move_sent_while_stop_decelerates_is_discarded(arm, executor, trace): 
     rest_at = arm.device.queued_end.joints.copy()
     steps(executor, 5)
     r = arm.move_ptp_joint_rel([5.0] * 7)
-    assert r.ok
+    assert r.ok and r.comment.startswith("discarded: stop")       # OK, and said
     late = r.values["motion_id"]
     rest(executor, arm)
     assert arm.device.was_discarded(late) and arm.device.completed == 0
     trace.check()
     trace.check_rest(rest_at)
-    assert arm.move_ptp_joint_rel([1.0] * 7).ok                   # at rest: runs again
+    r = arm.move_ptp_joint_rel([1.0] * 7)
+    assert r.ok and not r.comment                                 # at rest: runs again
     rest(executor, arm)
     assert arm.device.completed == 1
     trace.check()

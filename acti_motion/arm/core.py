@@ -968,7 +968,7 @@ class ArmCore:
                              finger, ramp, "gripper")
         return self._submit(plan, label)
 
-    def _submit(self, plan: Callable[[ArmSetpoint], ArmMotion], label: str) -> dict:
+    def _submit(self, plan: Callable[[ArmSetpoint], ArmMotion], label: str) -> dict | Reply:
         """Queue one planned move; inside `all_or_nothing` (on this thread), collect it."""
         guarded = self._guarded(plan, label)
         collected = getattr(self._batch, "plans", None)
@@ -978,6 +978,10 @@ class ArmCore:
         motion_id = self.device.submit(guarded, label)
         if motion_id is None:
             raise self._full()
+        why = self.device.doomed(motion_id)
+        if why is not None:         # OK as 5.4.19 has it, and said: its wait will say the same
+            return Reply(R.OK, f"discarded: {why} (a stop discards every command given until "
+                               "the arm is at rest)", {"motion_id": motion_id})
         return {"motion_id": motion_id}
 
     @contextmanager
