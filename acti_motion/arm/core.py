@@ -300,15 +300,16 @@ class ArmCore:
             return
         i = int(left[0])
         lj, lc = self.soft_limit_joint, self.soft_limit_cartesian
+        when = "with a move paused there" if d.paused else "while moving"
         if i < self.axis_count:
             alarm = Alarm(ALARM_JOINT_SOFT_LIMIT, AlarmType.WARNING,
-                          f"joint soft limit exceeded while moving: J{i + 1} = {values[i]:.3f}° "
+                          f"joint soft limit exceeded {when}: J{i + 1} = {values[i]:.3f}° "
                           f"left [{lj[i, 0]:g}, {lj[i, 1]:g}]°")
         else:
             axis = "xyz"[i - self.axis_count]
             lim = lc[i - self.axis_count]
             alarm = Alarm(ALARM_CARTESIAN_SOFT_LIMIT, AlarmType.WARNING,
-                          f"Cartesian soft limit exceeded while moving: {axis} = {values[i]:.2f} mm "
+                          f"Cartesian soft limit exceeded {when}: {axis} = {values[i]:.2f} mm "
                           f"left [{lim[0]:g}, {lim[1]:g}] mm")
         with self._alarm_lock:
             self._alarms.append(alarm)
