@@ -50,6 +50,14 @@ class Reply:
         return self.code == ReturnCode.OK
 
 
+def plans(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """Mark an operation that plans motion or waits for a plan under way: its node serves it on
+    the device's motion plane, so that the control plane (stop, pause, the getters) never waits
+    behind it. The mark survives `answers` and `returns` (functools.wraps copies it)."""
+    fn.plans = True
+    return fn
+
+
 def answers(fn: Callable[..., dict[str, Any] | Reply | None]) -> Callable[..., Reply]:
     """Wrap a core operation: its out-values dict becomes an OK reply, `Refused` a refusal, and
     any other exception (a bug, or input no check foresaw) NG with a comment that says what

@@ -18,20 +18,11 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from acti_bringup.serving.conversions import fill, request_reader
 from acti_motion.replies import Reply, ReturnCode
 
-# Operations that queue or re-plan motion: move_*, the gripper's and home moves, the base's
-# set_velocity (it re-times a running cruise).
-PLANNING = ("move_", "go_home", "open_gripper", "close_gripper", "set_velocity")
-
-
 @dataclass(frozen=True)
 class Operation:
     """An IDL operation: the service (and core method) name and its `acti_msgs` service type."""
     name: str
     srv_type: type
-
-    @property
-    def plans(self) -> bool:
-        return self.name.startswith(PLANNING)
 
 
 class Plane(Node):
@@ -73,11 +64,14 @@ def action_server(host: Node, action_type: Any, name: str, execute: Callable,
 def serve_operations(node: Node, motion: Plane, core: Any,
                      operations: tuple[Operation, ...], write_status: StatusWriter) -> list:
     """Create `~/<name>` for every row, calling `core.<name>(**request fields)`: on `motion`
-    for the rows that plan, on `node` for the others."""
+    for the operations the core marks as planning (`acti_motion.replies.plans`), on `node` for
+    the others."""
     services = []
     for op in operations:
-        handler = _handler(node, op, getattr(core, op.name), write_status)
-        host, name = (motion, motion.name(op.name)) if op.plans else (node, f"~/{op.name}")
+        method = getattr(core, op.name)
+        handler = _handler(node, op, method, write_status)
+        plans = getattr(method, "plans", False)
+        host, name = (motion, motion.name(op.name)) if plans else (node, f"~/{op.name}")
         services.append(host.create_service(op.srv_type, name, handler, qos_profile=SERVICE_QOS))
     node.get_logger().info(f"{len(services)} services under {node.get_fully_qualified_name()}/: "
                            + ", ".join(op.name for op in operations))

@@ -28,7 +28,7 @@ from acti_motion.executor import STOPPED, MotionExecutor
 from acti_motion.arm.kinematics import ArmKinematics, Unreachable, rotate_about
 from acti_motion.arm.poses import Frames, compose_relative, hg_to_pose, inverse, pose_to_hg
 from acti_motion.profiles import Trapezoid
-from acti_motion.replies import (Refused, Reply, ReturnCode, finite_number, finite_vector,
+from acti_motion.replies import (Refused, Reply, ReturnCode, finite_number, finite_vector, plans,
                                  ratio_percent, returns, value_error)
 from acti_motion.arm.trajectories import (ArcPath, ArmMotion, ArmSetpoint, CartesianLimits,
                                       CartesianPlanner, LinearJointPath, LinePath,
@@ -594,6 +594,7 @@ class ArmCore:
 
     # === middle-level port: moves =================================================================
     @returns(*MOVE)
+    @plans
     def move_ptp_joint_abs(self, joint_points: list[float]) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
         goal = np.radians(finite_vector(joint_points, self.axis_count, "joint_points"))
@@ -601,6 +602,7 @@ class ArmCore:
         return self.queue_joint_move(lambda start: goal, "move_ptp_joint_abs")
 
     @returns(*MOVE)
+    @plans
     def move_ptp_joint_rel(self, joint_points: list[float]) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
         step = finite_vector(joint_points, self.axis_count, "joint_points")
@@ -609,12 +611,14 @@ class ArmCore:
         return self.queue_joint_move(lambda start: start.joints + delta, "move_ptp_joint_rel")
 
     @returns(*MOVE)
+    @plans
     def go_home(self) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
         goal = np.radians(self.home)
         return self.queue_joint_move(lambda start: goal, "go_home")
 
     @returns(*MOVE)
+    @plans
     def move_ptp_cartesian_abs(self, car_point: tuple) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
         target, psi = self._car_point(car_point, "car_point")
@@ -622,6 +626,7 @@ class ArmCore:
         return self._queue_ptp_cartesian(lambda P0: target, "move_ptp_cartesian_abs", psi=psi)
 
     @returns(*MOVE)
+    @plans
     def move_ptp_cartesian_rel(self, car_point: tuple) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
         delta, turn = self._car_point(car_point, "car_point")
@@ -629,6 +634,7 @@ class ArmCore:
                                          "move_ptp_cartesian_rel", turn=turn)
 
     @returns(*MOVE)
+    @plans
     def move_linear_cartesian_abs(self, car_point: tuple) -> dict:
         self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
         target, psi = self._car_point(car_point, "car_point")
@@ -637,6 +643,7 @@ class ArmCore:
                                      psi=psi)
 
     @returns(*MOVE)
+    @plans
     def move_linear_cartesian_rel(self, car_point: tuple) -> dict:
         self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
         delta, turn = self._car_point(car_point, "car_point")
@@ -644,6 +651,7 @@ class ArmCore:
                                      "move_linear_cartesian_rel", turn=turn)
 
     @returns(*MOVE)
+    @plans
     def move_circular_cartesian_abs(self, car_point_r: tuple, car_point_t: tuple) -> dict:
         """2014 revision: arc from where the previous motion ends, through R's position, to T
         (R's orientation and elbow are not used)."""
@@ -656,6 +664,7 @@ class ArmCore:
                                      "move_circular_cartesian_abs", psi=psi)
 
     @returns(*MOVE)
+    @plans
     def move_circular_cartesian_rel(self, car_point_r: tuple, car_point_t: tuple) -> dict:
         self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
         via, _ = self._car_point(car_point_r, "car_point_r")
@@ -666,14 +675,17 @@ class ArmCore:
 
     # --- gripper -----------------------------------------------------------------------------------
     @returns(R.STATUS_ERR, R.VALUE_ERR, R.FULL_MOTION_QUEUE_ERR, R.NOT_SV_ON_ERR)
+    @plans
     def open_gripper(self) -> dict:
         return self.queue_gripper(100, "open_gripper")
 
     @returns(R.STATUS_ERR, R.FULL_MOTION_QUEUE_ERR, R.NOT_SV_ON_ERR)
+    @plans
     def close_gripper(self) -> dict:
         return self.queue_gripper(0, "close_gripper")
 
     @returns(R.STATUS_ERR, R.VALUE_ERR, R.NOT_SV_ON_ERR)
+    @plans
     def move_gripper(self, angle_ratio: int) -> dict:
         """The spec lists no FULL_MOTION_QUEUE_ERR here: a full queue is STATUS_ERR."""
         ratio = ratio_percent(angle_ratio, "angle_ratio")

@@ -7,7 +7,7 @@ import functools
 import math
 from typing import TYPE_CHECKING, Any, Callable
 
-from acti_motion.replies import Refused, ReturnCode, answers, finite_number
+from acti_motion.replies import Refused, ReturnCode, answers, finite_number, plans
 from acti_motion.vehicle.alarms import AlarmCode, Kind
 from acti_motion.vehicle.paths import Pose2D
 
@@ -40,16 +40,17 @@ def invalid(message: str) -> VehicleRefused:
     return VehicleRefused(AlarmCode.INVALID_VALUE, message)
 
 
-def _operation(clears_warnings: bool, plans: bool = False) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+def _operation(clears_warnings: bool, planning: bool = False) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
     """An IDL operation: a refusal raises its warning, success clears the command warnings, and
     any other failure is a refusal with a comment, never an exception. Control operations hold
-    the short state lock; planning operations (`plans`) hold only the planning lock, so that
-    stop, pause, the getters and the simulation never wait for a plan."""
+    the short state lock; planning operations (`planning`) hold only the planning lock, so that
+    stop, pause, the getters and the simulation never wait for a plan, and are marked `plans`
+    (their node serves them on the motion plane: one waits there for another's plan)."""
     def decorate(fn: Callable[..., Any]) -> Callable[..., Any]:
         @functools.wraps(fn)
         def recorded(self: "VehicleCore", *args: Any, **kwargs: Any) -> Any:
-            with (self.planning if plans else self.lock):
-                if plans:
+            with (self.planning if planning else self.lock):
+                if planning:
                     self._op_generation = self.device.generation
                 try:
                     out = fn(self, *args, **kwargs)
@@ -65,13 +66,13 @@ def _operation(clears_warnings: bool, plans: bool = False) -> Callable[[Callable
                 if clears_warnings:
                     self.alarms.clear(Kind.COMMAND)
                 return out
-        return answers(recorded)
+        return answers(plans(recorded) if planning else recorded)
     return decorate
 
 
 command = _operation(clears_warnings=True)    # changes something: success clears command warnings
 query = _operation(clears_warnings=False)     # reads: a refusal (unknown id) still warns
-planned = _operation(clears_warnings=True, plans=True)   # plans a motion or a new timing
+planned = _operation(clears_warnings=True, planning=True)   # plans a motion or a new timing
 
 
 def bounded_pair(values: Any, lower: tuple[float, float], limits: tuple[float, float], name: str,
