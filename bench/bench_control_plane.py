@@ -368,10 +368,6 @@ def lost_text(lost: list[str]) -> str:
         f"{lost.count(why)}x {why}" for why in dict.fromkeys(lost))
 
 
-def ms(x: float) -> str:
-    return f"{x * 1e3:7.2f}"
-
-
 def main(cases: str) -> None:
     """`cases`: the letters of the cases to run (all when empty)."""
     ros = RosClient(call_timeout=5.0)

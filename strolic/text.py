@@ -233,7 +233,10 @@ class Assembler:
         kind, word, _ = self.next()
         if kind != "hex":
             raise self.error("<hex bytes> expected")
-        return bytes.fromhex("".join(word[1:-1].split()))
+        try:
+            return bytes.fromhex("".join(word[1:-1].split()))
+        except ValueError:
+            raise self.error(f"{word!r}: hex bytes are pairs of hex digits") from None
 
     def literal(self, kind: str, word: str):
         if kind == "string":
@@ -300,16 +303,24 @@ def resolve_labels(codes: list[Code], labels: dict[str, int],
     return codes
 
 
+HEX_ESCAPE = re.compile(r"[0-9A-Fa-f]{1,2}")
+
 def unescape(body: str, assembler: Assembler) -> bytes:
     out, i = bytearray(), 0
     while i < len(body):
         char = body[i]
         if char != "\\":
+            if "\ud800" <= char <= "\udfff":
+                raise assembler.error(f"a lone surrogate (U+{ord(char):04X}) in a string: not "
+                                      "a character UTF-8 can hold")
             out += char.encode("utf-8")
             i += 1
         elif body[i + 1:i + 2] == "x":
-            out.append(int(body[i + 2:i + 4], 16))
-            i += 4
+            digits = HEX_ESCAPE.match(body, i + 2)
+            if digits is None:
+                raise assembler.error(f"{body[i:i + 4]!r}: \\x takes one or two hex digits")
+            out.append(int(digits.group(), 16))
+            i = digits.end()
         elif body[i + 1:i + 2] in ESCAPES:
             out.append(ESCAPES[body[i + 1]])
             i += 2

@@ -3,6 +3,7 @@ import math
 
 import pytest
 
+from acti_motion.executor import STALE
 from acti_motion.vehicle.core import VehicleState
 from sim_fixtures import executor, run_until  # noqa: F401
 from vehicle_fixtures import base, ready, settle, state, steps  # noqa: F401
@@ -172,6 +173,34 @@ def test_joystick_off_as_its_drive_ends_is_still_true(base, executor):  # noqa: 
     base.device.edit_planned = drive_ends_first
     r = base.set_joystick(False)
     assert r.ok and not base.joystick and not base.alarms.active(), r.comment
+
+
+@pytest.mark.parametrize("meanwhile", ["pause", "outrun"])
+def test_joystick_off_is_true_when_a_pause_or_the_base_outruns_its_brake(base, executor,  # noqa: F811
+                                                                          meanwhile):
+    """A pause between set_joystick's look and its brake's, or a brake the base outran on every
+    try, answered false and raised Warning-102, with the joystick already off (setJoystick:
+    常に真を返します). Paused, the drive stays held and its deadman ends it after resume."""
+    ready(base)
+    assert base.set_joystick(True).ok
+    for _ in range(10):
+        assert base.joy_input([0.0, 0.5], [])
+        steps(executor, 0.05)
+    edit_planned = base.device.edit_planned
+
+    def interfere(look, plan, tries=6):
+        if meanwhile == "pause":
+            assert base.pause().ok
+            return edit_planned(look, plan, tries)
+        return STALE
+    base.device.edit_planned = interfere
+    r = base.set_joystick(False)
+    assert r.ok and not base.joystick and not base.alarms.active(), r.comment
+    base.device.edit_planned = edit_planned
+    if meanwhile == "pause":
+        assert base.resume().ok
+    settle(executor, base, 5.0)
+    assert state(base) == VehicleState.READY
 
 
 def test_the_joystick_does_not_take_over_a_jog(base, executor):  # noqa: F811

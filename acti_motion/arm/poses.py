@@ -17,10 +17,6 @@ from acti_motion.replies import Refused, ReturnCode, finite_vector
 ROTATION_TOLERANCE = 1e-3
 
 
-def identity_hg() -> list[float]:
-    return pose_to_hg(np.eye(4))
-
-
 def hg_to_pose(values: Iterable[float], name: str,
                code: ReturnCode = ReturnCode.VALUE_ERR) -> np.ndarray:
     """A 4×4 pose (m) from an HgMatrix, else Refused(code) that says what is wrong."""

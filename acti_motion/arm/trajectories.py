@@ -266,9 +266,7 @@ class CartesianLimits:
 class CartesianPlan:
     path: SplineJointPath
     timing: Timing
-    elbow_turn: float         # rad the elbow turns about the shoulder-wrist line
     retimed: bool             # TOPP-RA timing instead of the nominal trapezoid
-    nominal: Trapezoid
 
 
 class CartesianPlanner:
@@ -289,9 +287,9 @@ class CartesianPlanner:
         speeds = np.array([limits.speed, limits.angular_speed, limits.angular_speed])
         nominal = Trapezoid.for_axes(extents, speeds, limits.ramp)
         if self._keeps_limits(spline, nominal, limits):
-            return CartesianPlan(spline, nominal, turn, False, nominal)
+            return CartesianPlan(spline, nominal, False)
         timing = time_optimal(spline.ss, spline.qs, extents, limits)
-        return CartesianPlan(spline, timing, turn, True, nominal)
+        return CartesianPlan(spline, timing, True)
 
     def check_length(self, path, frames: Frames) -> None:
         """Unreachable when `path` (a line or arc of this module) is longer than any path within

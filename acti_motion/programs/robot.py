@@ -4,7 +4,7 @@ that move the arm (the middle-level spec's high level, JOB execution).
 Every motion a program commands goes into the arm's one motion queue, the queue the services
 use, so program and service motions run in the order they were sent. A program keeps its own
 modal settings (JSPEED, SPEED, ACCEL/DECEL, SACC, configuration, hands), the services theirs.
-Units (DESIGN.md): lengths mm, joint values degree, SPEED mm/s, JSPEED %, times s.
+Units (the ACT ports'): lengths mm, joint values degree, SPEED mm/s, JSPEED %, times s.
 
 Blocking functions ($WAIT, DELAY, CALIB, a motion command on a full queue) wait the VM's way:
 the process waits and the scheduler looks again every `POLL` seconds of simulated time; the
@@ -25,7 +25,8 @@ from typing import Callable
 
 import numpy as np
 
-from acti_motion.arm.core import SERVO_OFF_REASON, ArmCore
+from acti_motion.arm.core import (SERVO_OFF_REASON, STATE_ALARM, STATE_MOVING, STATE_PAUSED,
+                                  ArmCore)
 from acti_motion.arm.blending import ARM_MOVES, blend_with_previous
 from acti_motion.arm.kinematics import Unreachable, rotate_about
 from acti_motion.arm.poses import compose_relative, hg_to_pose, inverse
@@ -160,6 +161,15 @@ def _wait_key(proc) -> tuple:
     return id(proc), id(proc.frame), proc.frame.pc
 
 
+
+def _shown_line(text: str) -> str:
+    """A console line or a PAUSE message as shown (result, progress): at most CONSOLE_LINE
+    characters, a longer one cut with its length said."""
+    if len(text) > CONSOLE_LINE:
+        return f"{text[:CONSOLE_LINE]}… ({len(text)} characters)"
+    return text
+
+
 def _push_flag(proc, code: int) -> None:
     proc.push(Num(I2, code))
 
@@ -212,8 +222,7 @@ class RobotHost(Host):
         """A console line (TRACE, warnings, flags, PAUSE messages), kept for the run's result:
         at most CONSOLE_LINE characters each and CONSOLE_BYTES in all; lines beyond are only
         counted (a traced 4 MiB string, ten times, put 168 MB into the result)."""
-        if len(text) > CONSOLE_LINE:
-            text = f"{text[:CONSOLE_LINE]}… ({len(text)} characters)"
+        text = _shown_line(text)
         if self._console_size + len(text) > CONSOLE_BYTES:
             self.lines_dropped += 1
         else:
@@ -278,9 +287,11 @@ class RobotHost(Host):
         arm = self.arm
         word = arm.state_word()
         opening = arm.get_feedback_pos_joint().values["pos"][7]
-        flags = (arm.servo, bool(word & 0x02), bool(word & 0x04), bool(word & 0x10),
-                 opening < HAND_TOLERANCE_MM, opening > self.max_opening - HAND_TOLERANCE_MM)
-        return sum(1 << i for i, on in enumerate(flags) if on)
+        flags = {"servo on": arm.servo, "moving": bool(word & STATE_MOVING),
+                 "alarm": bool(word & STATE_ALARM), "paused": bool(word & STATE_PAUSED),
+                 "hand closed": opening < HAND_TOLERANCE_MM,
+                 "hand open": opening > self.max_opening - HAND_TOLERANCE_MM}
+        return sum(1 << i for i, name in enumerate(STATUS_BITS) if flags[name])
 
     # === the program's motions ===================================================================
     def _issued(self, motion_id: int) -> None:
@@ -648,8 +659,9 @@ class RobotHost(Host):
         self.console(f"PAUSE: {message}")
         arm = self.arm
         generation = arm.device.generation          # a stop (servo off, an alarm) changes it
+        servo, alarms = arm.servo, {a.as_tuple() for a in arm.alarms}
         arm.device.pause(arm.current_ramp())
-        self.state, self.message = "paused", message
+        self.state, self.message = "paused", _shown_line(message)
         started = self.now()
         try:
             while arm.device.paused:
@@ -659,9 +671,12 @@ class RobotHost(Host):
             self._frozen += self.now() - started
             self._last_check = self.now()
             self.state, self.message = "running", ""
-        if arm.device.generation != generation or not arm.servo or arm.alarms:
-            # the pause ended by a stop, not a resume: the program must not go on moving
-            raise fail(K.SERVO_ERROR if not arm.servo else K.ROBOT_ERROR,
+        servo_lost = servo and not arm.servo
+        if (arm.device.generation != generation or servo_lost
+                or any(a.as_tuple() not in alarms for a in arm.alarms)):
+            # the pause ended by a stop meanwhile, not a resume: the program must not go on
+            # moving (a servo already off or an alarm already there before it does not count)
+            raise fail(K.SERVO_ERROR if servo_lost else K.ROBOT_ERROR,
                        "the arm was stopped while the program was paused (stop, servo off or "
                        "an alarm; only resume goes on)")
         _push_flag(proc, 0)

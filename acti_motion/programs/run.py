@@ -58,32 +58,47 @@ class ProgramResult:
 
 
 MAX_PROGRAM = 1 << 20      # bytes (code) or characters (text) of a program
-RESULT_ITEM = 65536        # bytes of a stack item's data shown in the result …
-RESULT_ITEMS = 1000        # … and the top-most stack items shown
+RESULT_ITEM = 65536        # characters of a stack item shown in the result …
+RESULT_ITEMS = 1000        # … the top-most stack items shown …
+RESULT_CHARS = 1 << 20     # … and the characters formatted for all of them
 
 
 def load(program: bytes | str) -> list:
     """Decoded codes of a program in the text form (str) or as code (bytes); StrolicError when
     it does not assemble or decode, or is longer than MAX_PROGRAM (a 2 MB text takes seconds
-    to assemble)."""
+    to assemble). Any other failure of the assembler or decoder is invalid code too: a flaw
+    there must not look like a fault of the controller."""
     if len(program) > MAX_PROGRAM:
         raise StrolicError(K.INVALID_CODE, f"the program is {len(program)} "
                            f"{'characters' if isinstance(program, str) else 'bytes'} long: at most "
                            f"{MAX_PROGRAM} (1 MiB)")
-    return decode(assemble(program) if isinstance(program, str) else bytes(program))
+    try:
+        return decode(assemble(program) if isinstance(program, str) else bytes(program))
+    except StrolicError:
+        raise
+    except Exception as e:
+        raise StrolicError(K.INVALID_CODE, f"the program does not load ({type(e).__name__}: "
+                           f"{e})") from None
 
 
 def shown_stack(stack: list) -> list[str]:
-    """The final stack in the text form, bottom first: its top RESULT_ITEMS items, each whose
-    data is longer than RESULT_ITEM bytes by its size only (DUP shares a datum, so 13 copies of
-    an 8 MB string made 436 MB of result text)."""
-    shown = [f"… {len(stack) - RESULT_ITEMS} items below not shown"] \
-        if len(stack) > RESULT_ITEMS else []
-    for item in stack[-RESULT_ITEMS:]:
+    """The final stack in the text form, bottom first: its top RESULT_ITEMS items, each in at
+    most RESULT_ITEM characters and all in about RESULT_CHARS (the top first), the others by
+    their size only. DUP shares a datum and a byte can take four characters (\\xNN): 13
+    copies of an 8 MB string made 436 MB of result text, and 1000 of 64 KiB 262 MB."""
+    budget = RESULT_CHARS
+    shown = []
+    for item in reversed(stack[-RESULT_ITEMS:]):
         data = getattr(item, "data", None) or getattr(item, "body", b"")
-        shown.append(f"{type(item).__name__}<{len(data)} bytes, not shown>"
-                     if len(data) > RESULT_ITEM else format_value(item))
-    return shown
+        # formatting costs at least a character a byte: the budget bounds that work too
+        text = format_value(item) if len(data) <= min(RESULT_ITEM, budget) else ""
+        budget -= len(text)
+        if data and (not text or len(text) > RESULT_ITEM or budget < 0):
+            text = f"{type(item).__name__}<{len(data)} bytes, not shown>"
+        shown.append(text)
+    if len(stack) > RESULT_ITEMS:
+        shown.append(f"… {len(stack) - RESULT_ITEMS} items below not shown")
+    return shown[::-1]
 
 
 class ProgramRun:

@@ -528,9 +528,13 @@ class VehicleCore(Sensing):
         cur = self.device.current
         if not on_off and cur is not None and cur.label == "joystick" and not self.device.paused:
             c = self.config
-            self._drive((0.0, 0.0), 0.0, (c.accel_limit_translation / 1000.0,
-                                          math.radians(c.accel_limit_rotation)), "joystick",
-                        take_over=False, brake=True)
+            try:
+                self._drive((0.0, 0.0), 0.0, (c.accel_limit_translation / 1000.0,
+                                              math.radians(c.accel_limit_rotation)), "joystick",
+                            take_over=False, brake=True)
+            except VehicleRefused:
+                pass    # the base outran every plan of the brake: the drive's deadman ends it
+                        # (setJoystick always answers true)
 
     def joy_input(self, axes: list[float], buttons: list[int]) -> bool:
         """A sensor_msgs/Joy sample (not an IDL operation): full stick = the velocity setting.
@@ -692,11 +696,11 @@ class VehicleCore(Sensing):
         now unless called again. A `brake` of the running drive goes in whatever is queued
         behind it, and discards that (planned from the drive's old end; the base goes Ready)."""
         def look(device: Device, attempt: int):
+            cur = self._running(device)
+            if brake and (device.paused or cur is None or cur.label != label):
+                return None     # over already, or held by a pause (its deadman ends it after)
             if device.paused:
                 raise VehicleRefused(AlarmCode.WRONG_STATE, PAUSED_DRIVE.format(label))
-            cur = self._running(device)
-            if brake and (cur is None or cur.label != label):
-                return None                         # the drive is over already: nothing to brake
             if not take_over and (device.queue and not brake
                                   or cur is not None and cur.label != label):
                 raise self._busy(label)         # the joystick drives no further than its own

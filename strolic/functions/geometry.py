@@ -180,7 +180,7 @@ devh = deviation(True)
 
 
 def padd(vm: VM, proc: Process) -> None:
-    """PADD a b: the pose reached by the relative move a from b (DESIGN.md: p' = p + Δp,
+    """PADD a b: the pose reached by the relative move a from b (as the arm's Rel moves: p' = p + Δp,
     R' = ΔR·R in the robot frame); configuration from a, elbow angles add."""
     base, _, base_elbow = pop_pose(proc)
     delta, configuration, elbow = pop_pose(proc)

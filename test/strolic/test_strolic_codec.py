@@ -81,6 +81,18 @@ def test_invalid_codes_are_reported(text: str, reason: str) -> None:
     assert caught.value.offset is not None
 
 
+@pytest.mark.parametrize("text, says", [
+    ("Rd<0>", "pairs of hex digits"), ("Rd<0 1 2>", "pairs of hex digits"),
+    ('"\\x"', "one or two hex digits"), ('"\\xZZ"', "one or two hex digits"),
+    ('"\ud800"', "lone surrogate"),
+])
+def test_texts_that_do_not_assemble_are_invalid_code(text: str, says: str) -> None:
+    """They escaped as ValueError and UnicodeEncodeError: a run ended as a controller fault."""
+    with pytest.raises(StrolicError) as caught:
+        assemble(text)
+    assert caught.value.kind is K.INVALID_CODE and says in str(caught.value)
+
+
 @pytest.mark.parametrize("element, bad, at", [
     ("F6", "7FF0000000000000", 9 * 8),             # R8 elements, the tenth +inf
     ("F5", "7FC00000", 9 * 4),                     # R4, NaN

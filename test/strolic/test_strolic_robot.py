@@ -10,10 +10,12 @@ import pytest
 
 from acti_motion.arm.core import ArmConfig, ArmCore
 from acti_motion.executor import MotionExecutor
-from acti_motion.programs.run import ProgramRun, Status
+from acti_motion.programs.run import RESULT_CHARS, RESULT_ITEM, ProgramRun, Status, shown_stack
 from acti_sim.world import World
 from sim_fixtures import executor  # noqa: F401
+from strolic.codes import Str
 from strolic.errors import ExceptionKind as K
+from strolic.literals import format_value
 from strolic_robot_cases import CASES, WORK, Check, numbers
 
 MAX_SIM_SECONDS = 60.0
@@ -163,6 +165,53 @@ def test_progress_while_paused_counts_the_instructions_run(arm, executor):  # no
     assert program.run().status is Status.FINISHED
     assert seen and {p.state for p in seen} == {"paused"}
     assert {p.instructions for p in seen} == {7}                # 1 2 3 DROP×3 "hold": PAUSE runs
+
+
+def test_a_long_pause_message_is_shown_cut(arm, executor):  # noqa: F811
+    """The console line was cut, but the progress (the action's feedback, at its rate) carried
+    the whole message: 8 MiB a message while the program stayed paused."""
+    program = ProgramRun(arm, '"' + "x" * 5000 + '" PAUSE', step=None)
+    seen = []
+
+    def step():
+        executor.step()
+        if arm.device.paused:
+            seen.append(program.progress())
+            assert arm.resume().ok
+    program.host.step = step
+    assert program.run().status is Status.FINISHED
+    assert len(seen[0].message) < 4200 and seen[0].message.endswith("(5000 characters)")
+
+
+@pytest.mark.parametrize("before", ["servo off", "alarm"])
+def test_a_pause_resumed_goes_on_whatever_was_so_before_it(arm, executor, before):  # noqa: F811
+    """Only a stop, servo-off or alarm during the pause ends it as an exception: with the servo
+    off or an alarm since before the program, a resume ended it as one too, so a program that
+    only pauses (I/O, DELAY, PAUSE) could never go on."""
+    if before == "servo off":
+        assert arm.servo_off().ok
+    else:
+        assert arm.set_speed_joint(50).ok and arm.move_ptp_joint_rel([20, 0, 0, 0, 0, 0, 0]).ok
+        for _ in range(60):
+            executor.step()
+        z = arm.tool_pose(arm.feedback_joints)[2, 3] * 1000.0
+        assert arm.set_soft_limit_cartesian((2000, -2000), (2000, -2000), (2000, z + 500.0)).ok
+        for _ in range(250):
+            executor.step()
+        assert arm.alarms
+    result = run(arm, executor, '1 "check the part" PAUSE', resume_after=0.5)
+    assert result.status is Status.FINISHED, result.report
+    assert result.stack == ["1", "I2:0"]
+
+
+def test_the_shown_stack_counts_characters_not_bytes():
+    """A byte can take four characters (\\xNN): 1000 items of 64 KiB (DUP) made 262 MB."""
+    big, small = Str(b"\x00" * RESULT_ITEM), Str(b"\x00" * 1000)
+    shown = shown_stack([big] * 1000)
+    assert set(shown) == {f"Str<{RESULT_ITEM} bytes, not shown>"}
+    shown = shown_stack([small] * 1000)
+    assert shown[-1] == format_value(small) and shown[0] == "Str<1000 bytes, not shown>"
+    assert sum(map(len, shown)) < RESULT_CHARS + 40 * 1000
 
 
 def arm_rest_after(executor, arm, since):  # noqa: F811
