@@ -46,11 +46,18 @@ class ExceptionKind(enum.Enum):
     STOPPED = "stopped by the operator"    # the run was canceled (robot binding)
 
 
+DETAIL_CHARS = 1000     # of an exception's detail: it quotes the program (a 1 MB token)
+
+
 class StrolicError(Exception):
-    """An exception state: what happened, in which function, at which byte offset."""
+    """An exception state: what happened, in which function, at which byte offset. The detail
+    is cut to DETAIL_CHARS characters: it goes into results and log lines, and quotes what the
+    program holds (a 1 MB bad token was echoed whole into both)."""
 
     def __init__(self, kind: ExceptionKind, detail: str = "", *,
                  function: str | None = None, offset: int | None = None) -> None:
+        if len(detail) > DETAIL_CHARS:
+            detail = f"{detail[:DETAIL_CHARS]}… ({len(detail)} characters)"
         super().__init__(detail)
         self.kind = kind
         self.detail = detail

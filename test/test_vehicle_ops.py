@@ -421,3 +421,21 @@ def test_a_ready_only_move_during_a_stop_is_true_and_discarded(base, executor, m
     assert r.ok and r.comment.startswith("discarded: the base is stopping"), r.comment
     settle(executor, base, 3.0)
     assert state(base) == VehicleState.READY
+
+
+@pytest.mark.parametrize("move", [lambda b: b.move_forward(1e308),
+                                  lambda b: b.move_linear_rel((1e308, 0.0, 0.0)),
+                                  lambda b: b.move_continuous_rel((0.0, -3e5, 0.0))])
+@pytest.mark.parametrize("stopping", [False, True])
+def test_a_step_that_leaves_the_work_area_from_any_start_is_refused_in_every_state(
+        base, executor, move, stopping):  # noqa: F811
+    """During a stop's deceleration a 1e308 mm step was true and discarded, though it is wrong
+    whatever the start (the arm's VALUE_ERR rule): refused, warning 101, saying why."""
+    ready(base)
+    if stopping:
+        base.move_forward(-600.0)
+        steps(executor, 0.8)
+        assert base.stop().ok
+    r = move(base)
+    assert not r.ok and "longer than the work area's diagonal" in r.comment, r.comment
+    assert [a.code for a in base.alarms.active()] == [101]

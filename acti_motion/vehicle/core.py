@@ -347,6 +347,7 @@ class VehicleCore(Sensing):
     @planned
     def move_forward(self, x: float) -> dict:
         distance = finite_number(x, "x") / 1000.0
+        self._check_step(distance, 0.0, "x")
         self._require(IDLE, "move_forward")
         limits = self._limits()
 
@@ -367,6 +368,7 @@ class VehicleCore(Sensing):
     def move_linear_rel(self, pos: Any) -> dict:
         rel = finite_pose(pos)
         self._check_rotation(rel.theta, "pos.theta")
+        self._check_step(rel.x, rel.y, "pos")
         self._require(IDLE, "move_linear_rel")
         limits = self._limits()
 
@@ -457,6 +459,7 @@ class VehicleCore(Sensing):
         した場合，最後に設定された目標点以外は消去; 移動中に実行すると…新たな経路へと移行)."""
         rel = finite_pose(pos)
         self._check_rotation(rel.theta, "pos.theta")
+        self._check_step(rel.x, rel.y, "pos")
         self._require(SERVO_ON, "move_continuous_rel")
         limits, label = self._limits(), "move_continuous_rel"
 
@@ -606,6 +609,15 @@ class VehicleCore(Sensing):
             raise invalid(f"{what} ({1000.0 * goal.x:.10g}, {1000.0 * goal.y:.10g}) mm is outside "
                           f"the work area (±{area:g} mm in x and y)")
         return goal
+
+    def _check_step(self, dx: float, dy: float, what: str) -> None:
+        """Refuse a relative step (m) longer than the work area's diagonal: it ends outside from
+        any start, so it is wrong in every state (checked before the state, as absolute targets
+        are; during a stop's deceleration it was true and discarded)."""
+        length, diagonal = math.hypot(dx, dy), 2.0 * math.sqrt(2.0) * self.config.work_area
+        if not 1000.0 * length <= diagonal:
+            raise invalid(f"{what} is a step of {1000.0 * length:.10g} mm: longer than the work "
+                          f"area's diagonal ({diagonal:.0f} mm), it ends outside it from any start")
 
     def _check_rotation(self, angle: float, what: str) -> None:
         limit = self.config.turn_limit

@@ -321,3 +321,10 @@ def test_a_long_datum_is_formatted_without_an_object_per_byte(value) -> None:
     peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()
     assert len(text) > 1 << 19 and peak < 12 * len(text)
+
+
+def test_an_exception_quotes_at_most_a_thousand_characters_of_the_program() -> None:
+    """A 1 MB bad token was echoed whole into the run's result and its log line."""
+    with pytest.raises(StrolicError) as caught:
+        assemble("1 DROP " + "y" * 100000)
+    assert len(caught.value.report()) < 1100 and caught.value.report().endswith(" characters)")
