@@ -16,7 +16,7 @@ from .host import Host
 from .interrupts import Interrupts
 from .process import (BUILTIN, CYCLE_WAIT, INDIRECT, PUSH, USER, WAIT, Frame, Process,
                       State)
-from .values import check_datum_size, data_of
+from .values import ENTRY_BYTES, check_datum_size, data_of
 from .variables import Scope, find
 
 SLICE = 200              # instructions a process runs before the scheduler looks again
@@ -97,15 +97,23 @@ class VM:
     # ---- memory ---------------------------------------------------------------------------------
     def heap_in_use(self) -> int:
         """Bytes of the registrations of every scope, shadowed ones included (choice 24)."""
+        return sum(b.size() or 0 for b in self._registrations())
+
+    def _registrations(self) -> list:
         scopes = [self.globals] + [s for p in self.processes.values() for s in p.scopes[1:]]
-        return sum(b.size() or 0 for s in scopes for stack in s.table.values() for b in stack)
+        return [b for s in scopes for stack in s.table.values() for b in stack]
 
     def memory_in_use(self) -> int:
-        """Bytes of data held: the data stacks (a datum shared by DUP counted once), the heap,
-        and what the host keeps for the program."""
-        held = {id(item): item for p in self.processes.values() for item in p.stack
-                if isinstance(item, DATA_TYPES)}
-        return (sum(len(data_of(item)) for item in held.values()) + self.heap_in_use()
+        """Bytes of data held: the data stacks and channels (a datum shared by DUP counted once),
+        the heap, ENTRY_BYTES a registration and a flag that is on, and what the host keeps for
+        the program."""
+        items = [*(item for p in self.processes.values() for item in p.stack),
+                 *self.channels.values()]
+        held = {id(item): item for item in items if isinstance(item, DATA_TYPES)}
+        registrations = self._registrations()
+        return (sum(len(data_of(item)) for item in held.values())
+                + sum(b.size() or 0 for b in registrations)
+                + (len(registrations) + len(self.flags)) * ENTRY_BYTES
                 + self.host.memory_in_use() + self.code_in_use())
 
     def code_in_use(self) -> int:

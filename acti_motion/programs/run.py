@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import enum
 import threading
+from typing import Any, Callable, Iterable
 from dataclasses import dataclass, field
 
 from acti_motion.arm.core import ArmCore
@@ -81,24 +82,41 @@ def load(program: bytes | str) -> list:
                            f"{e})") from None
 
 
-def shown_stack(stack: list) -> list[str]:
-    """The final stack in the text form, bottom first: its top RESULT_ITEMS items, each in at
-    most RESULT_ITEM characters and all in about RESULT_CHARS (the top first), the others by
-    their size only. DUP shares a datum and a byte can take four characters (\\xNN): 13
-    copies of an 8 MB string made 436 MB of result text, and 1000 of 64 KiB 262 MB."""
-    budget = RESULT_CHARS
-    shown = []
-    for item in reversed(stack[-RESULT_ITEMS:]):
-        data = getattr(item, "data", None) or getattr(item, "body", b"")
-        # formatting costs at least a character a byte: the budget bounds that work too
-        text = format_value(item) if len(data) <= min(RESULT_ITEM, budget) else ""
+def _bounded(entries: Iterable, size_of: Callable[[Any], int], text_of: Callable[[Any], str],
+             note_of: Callable[[Any], str]) -> list[str]:
+    """Each entry's text while the texts keep within RESULT_ITEM characters each and about
+    RESULT_CHARS in all, else its note. DUP shares a datum and a byte can take four characters
+    (\\xNN): 13 copies of an 8 MB string made 436 MB of result text, 1000 of 64 KiB 262 MB,
+    and RESULT in a loop 120 MB of output. Formatting costs at least a character a byte, so the
+    budget bounds that work too."""
+    budget, shown = RESULT_CHARS, []
+    for entry in entries:
+        size = size_of(entry)
+        text = text_of(entry) if size <= min(RESULT_ITEM, budget) else ""
         budget -= len(text)
-        if data and (not text or len(text) > RESULT_ITEM or budget < 0):
-            text = f"{type(item).__name__}<{len(data)} bytes, not shown>"
+        if size and (not text or len(text) > RESULT_ITEM or budget < 0):
+            text = note_of(entry)
         shown.append(text)
+    return shown
+
+
+def shown_stack(stack: list) -> list[str]:
+    """The final stack in the text form, bottom first: its top RESULT_ITEMS items, bounded
+    (`_bounded`) from the top down, the others by their size only."""
+    def data(item: Any) -> bytes:
+        return getattr(item, "data", None) or getattr(item, "body", b"")
+    shown = _bounded(reversed(stack[-RESULT_ITEMS:]), lambda item: len(data(item)), format_value,
+                     lambda item: f"{type(item).__name__}<{len(data(item))} bytes, not shown>")
     if len(stack) > RESULT_ITEMS:
         shown.append(f"… {len(stack) - RESULT_ITEMS} items below not shown")
     return shown[::-1]
+
+
+def shown_output(output: list[bytes]) -> list[str]:
+    """What the program sent (SYNC, RESULT) in the text form, first first, bounded
+    (`_bounded`); the rest by size only."""
+    return _bounded(output, len, lambda data: " ".join(map(format_code, decode(data))),
+                    lambda data: f"<{len(data)} bytes sent, not shown>")
 
 
 class ProgramRun:
@@ -146,7 +164,7 @@ class ProgramRun:
             if host.lines_dropped else []
         self.result = ProgramResult(
             status, error, shown_stack(vm.main.stack) if vm.main else [],
-            [" ".join(format_code(code) for code in decode(data)) for data in host.output],
+            shown_output(host.output),
             host.lines + dropped, vm.executed, host.now() - start)
         return self.result
 

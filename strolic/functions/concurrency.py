@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 from ..codes import I2, Num, user_key
 from ..errors import ExceptionKind as K, fail
 from ..process import CYCLE_WAIT, RETRY, WAIT, Process, State
+from ..values import ENTRY_BYTES
 from ..variables import find
 from .args import expect, function_of, integer_value, pop_count, pop_many, pop_num, pop_user
 
@@ -135,6 +136,13 @@ tkill, tsuspend, tresume = (task_control(a) for a in ("kill", "suspend", "resume
 
 
 # ---- event flags --------------------------------------------------------------------------------
+def _flag_on(vm: VM, number: int) -> None:
+    """A flag on: counted as data held (flags of distinct numbers in a loop grew unbounded)."""
+    if number not in vm.flags:
+        vm.account(ENTRY_BYTES)
+        vm.flags.add(number)
+
+
 def flag_number(item) -> int:
     """Event-flag and channel numbers are positive (EPOP uses 0 for 'no event')."""
     number = integer_value(expect(item, Num, "an event-flag number"))
@@ -161,7 +169,7 @@ def lock(vm: VM, proc: Process):
     if number in vm.flags:
         return WAIT
     proc.pop()
-    vm.flags.add(number)
+    _flag_on(vm, number)
     vm.changed()
     return None
 
@@ -218,7 +226,7 @@ def epop(vm: VM, proc: Process) -> None:
 
 
 def esig(vm: VM, proc: Process) -> None:
-    vm.flags.add(flag_number(proc.pop()))
+    _flag_on(vm, flag_number(proc.pop()))
     vm.changed()
 
 
@@ -255,7 +263,7 @@ def chout(vm: VM, proc: Process):
     value = proc.pop()
     proc.pop()
     vm.channels[number] = value
-    vm.flags.add(number)
+    _flag_on(vm, number)
     vm.changed()
     return None
 

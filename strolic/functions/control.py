@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 from ..codes import VAR_CODE, Function, FunctionCode, UserCode, user_key
 from ..errors import ExceptionKind as K, fail
 from ..process import PUSH, Process
+from ..values import ENTRY_BYTES
 from ..variables import Scope, declare, find, find_at_level, free as free_binding
 from .args import expect, pop_count, pop_num, pop_user
 
@@ -140,6 +141,7 @@ def dcl(vm: VM, proc: Process) -> None:
     keys = _declared_codes(proc)
     if len(set(keys)) != len(keys):
         raise fail(K.TYPE_MISMATCH, "a user code appears twice in one declaration")
+    vm.account(ENTRY_BYTES * len(keys))
     for key in reversed(keys):
         declare(proc.scopes[-1], key)
 

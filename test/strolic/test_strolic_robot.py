@@ -10,12 +10,14 @@ import pytest
 
 from acti_motion.arm.core import ArmConfig, ArmCore
 from acti_motion.executor import MotionExecutor
-from acti_motion.programs.run import RESULT_CHARS, RESULT_ITEM, ProgramRun, Status, shown_stack
+from acti_motion.programs.run import (RESULT_CHARS, RESULT_ITEM, ProgramRun, Status, shown_output,
+                                      shown_stack)
 from acti_sim.world import World
 from sim_fixtures import executor  # noqa: F401
 from strolic.codes import Str
 from strolic.errors import ExceptionKind as K
 from strolic.literals import format_value
+from strolic.values import encode_value
 from strolic_robot_cases import CASES, WORK, Check, numbers
 
 MAX_SIM_SECONDS = 60.0
@@ -211,6 +213,10 @@ def test_the_shown_stack_counts_characters_not_bytes():
     assert set(shown) == {f"Str<{RESULT_ITEM} bytes, not shown>"}
     shown = shown_stack([small] * 1000)
     assert shown[-1] == format_value(small) and shown[0] == "Str<1000 bytes, not shown>"
+    assert sum(map(len, shown)) < RESULT_CHARS + 40 * 1000
+    sent = [encode_value(small)] * 1000                     # RESULT in a loop: 120 MB of output
+    shown = shown_output(sent)
+    assert shown[0] == format_value(small) and shown[-1].endswith("bytes sent, not shown>")
     assert sum(map(len, shown)) < RESULT_CHARS + 40 * 1000
 
 

@@ -283,3 +283,13 @@ def test_heap_counts_areas_with_their_tags_and_free_gives_them_back() -> None:
                "997 #St(0) #y ALLOC #y ASIZE")          # 1001: one short, nothing secured
     assert stack_of(program, heap_limit=1000) == ["1000", "103", "897", "895", "897", "1000",
                                                   "1000", "0", "-1", "I2:-1"]
+
+
+@pytest.mark.parametrize("step", ["VAR #y DCL", "n ESIG #n n 1 ADD STORE",
+                                  'n s "B" CONC CHOUT #n n 1 ADD STORE'])
+def test_registrations_flags_and_channel_data_count_as_data_held(step: str) -> None:
+    """DCL in a loop grew to 1.1 GB, flags of new numbers without end, and data left in
+    channels to 2.9 GB, with nothing counted against the memory limit."""
+    program = (f'.name s %1005 .name y %1006 .name n %1007 VAR #s #n DCL #s "{"A" * 1000}" STORE '
+               f"#n I4:1 STORE #f Fn{{ top: {step} >top BRA END }} STORE f")
+    assert error_of(program, budget=None, memory_limit=1_000_000).kind is K.MEMORY_EXHAUSTED
