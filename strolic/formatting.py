@@ -246,6 +246,35 @@ def _c_argument(conversion: bytes, value: Scalar):
     return float(value.value)       # C promotes a float to double: an R4's exact value
 
 
+def _c_integer(number: int, flags: bytes, width: int, precision: int | None,
+               conversion: bytes) -> bytes:
+    """An integer conversion by C89's rules (4.9.6.1), which Python's % departs from: the
+    precision is the least number of digits (0 of 0 with precision 0 is no digit) and turns
+    the 0 flag off; + and space sign only d and i (u is d here, Annex 2); # gives o a leading
+    0 and a nonzero x a 0x."""
+    base = {b"o": 8, b"x": 16, b"X": 16}.get(conversion, 10)
+    digits = b"" if precision == 0 and number == 0 else (
+        format(abs(number), {8: "o", 16: "x", 10: "d"}[base]).encode())
+    digits = digits.rjust(1 if precision is None else precision, b"0")
+    if conversion == b"X":
+        digits = digits.upper()
+    prefix = b""
+    if conversion in b"diu":
+        prefix = b"-" if number < 0 else b"+" if b"+" in flags else b" " if b" " in flags else b""
+    elif b"#" in flags and conversion == b"o" and not digits.startswith(b"0"):
+        digits = b"0" + digits
+    elif b"#" in flags and number != 0 and conversion in b"xX":
+        prefix = b"0" + conversion
+    pad = width - len(prefix) - len(digits)
+    if pad <= 0:
+        return prefix + digits
+    if b"-" in flags:
+        return prefix + digits + b" " * pad
+    if b"0" in flags and precision is None:
+        return prefix + b"0" * pad + digits
+    return b" " * pad + prefix + digits
+
+
 def c_encode(template: bytes, values: list[Scalar]) -> bytes:
     """ENCODE2: ``sprintf``; extra data are ignored, too few are a conversion error."""
     out = bytearray()
@@ -279,21 +308,12 @@ def c_encode(template: bytes, values: list[Scalar]) -> bytes:
         if any(part and part != b"*" and int(part) > MAX_WIDTH for part in (width, precision)):
             raise conversion_error(f"a width or precision above {MAX_WIDTH}")
         argument = _c_argument(conversion, take(f"%{conversion.decode()}"))
-        spec = b"%" + flags + (width or b"") + (b"." + precision if precision is not None
-                                                 else b"") + (b"d" if conversion == b"u"
-                                                              else conversion)
-        if conversion == b"o" and b"#" in flags:               # C's 017, not Python's 0o17
-            spec = spec.replace(b"#", b"")
-            text = spec % argument
-            digits = text.strip(b" ")
-            if not digits.startswith(b"0"):
-                digits = b"0" + digits
-                text = digits.ljust(len(text)) if b"-" in flags else digits.rjust(len(text))
-            out += text
-        elif conversion in b"xX" and b"#" in flags and argument == 0:   # C: 0, not 0x0
-            out += spec.replace(b"#", b"") % argument
+        if conversion in b"diuoxX":
+            out += _c_integer(argument, flags, int(width or 0),
+                              None if precision is None else int(precision or 0), conversion)
         else:
-            out += spec % argument
+            out += (b"%" + flags + (width or b"") + (b"." + precision if precision is not None
+                                                     else b"") + conversion) % argument
         check_datum_size(len(out))
     return bytes(out)
 

@@ -328,3 +328,33 @@ def test_an_exception_quotes_at_most_a_thousand_characters_of_the_program() -> N
     with pytest.raises(StrolicError) as caught:
         assemble("1 DROP " + "y" * 100000)
     assert len(caught.value.report()) < 1100 and caught.value.report().endswith(" characters)")
+
+
+def _libc_snprintf(template: bytes, value: int) -> bytes:
+    """C's own answer: glibc's snprintf with one int argument."""
+    import ctypes
+    buffer = ctypes.create_string_buffer(256)
+    ctypes.CDLL("libc.so.6").snprintf(buffer, 256, template, ctypes.c_int(value))
+    return buffer.value
+
+
+@pytest.mark.parametrize("conversion", ["d", "i", "o", "x", "X"])
+def test_encode2_integer_conversions_are_c89s(conversion: str) -> None:
+    """Annex 2: 書式指定は,基本的にANSI Cに従う. Python's % gave %.0d of 0 as 0, signed %+x
+    and % o, kept the 0 flag with a precision and wrote %#+o of 1 as 0+1 (about 50 of the
+    flag combinations differed from C)."""
+    from strolic.formatting import c_encode
+    flag_sets = ["", "-", "+", " ", "#", "0", "-+", "+0", " 0", "#0", "#-", "+#", "-0", "#+ 0"]
+    differ = []
+    for flags in flag_sets:
+        if conversion in "di" and "#" in flags:
+            continue                                        # undefined in C
+        for width in ["", "1", "6"]:
+            for precision in ["", ".", ".0", ".1", ".4"]:
+                for value in [0, 1, 5, 8, 42, 255, 2147483647] + (
+                        [-1, -42, -2147483648] if conversion in "di" else []):
+                    template = f"%{flags}{width}{precision}{conversion}".encode()
+                    got = c_encode(template, [Num(I4, value)])
+                    if got != _libc_snprintf(template, value):
+                        differ.append((template, value, got, _libc_snprintf(template, value)))
+    assert differ == []
