@@ -11,27 +11,9 @@ from acti_motion.arm.kinematics import wrap
 from acti_motion.arm.poses import hg_to_pose, orientation_error_deg, position_error_mm, pose_to_hg
 from acti_motion.replies import ReturnCode as R
 from acti_motion.arm.trajectories import ConstAccelTiming, Trapezoid
+from arm_fixtures import IDENTITY, WORK, arm, rest  # noqa: F401
 from sim_fixtures import executor, run_until  # noqa: F401
 from trajectory_check import ArmTrace
-
-IDENTITY = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
-WORK = [0.0, 45.0, 0.0, -90.0, 0.0, 45.0, 0.0]      # wrist above the shoulder, flange up
-
-
-@pytest.fixture
-def arm(executor):  # noqa: F811
-    a = ArmCore(executor, ArmConfig(queue_size=8, initial_joints_deg=tuple(WORK)))
-    for r in (a.servo_on(), a.set_speed_joint(50), a.set_speed_cartesian(50)):
-        assert r.ok
-    return a
-
-
-def rest(executor, arm, max_seconds=15.0, settle=60):  # noqa: F811
-    took = run_until(executor, lambda: not arm.device.busy, max_seconds)
-    for _ in range(settle):
-        executor.step()
-    return took
-
 
 def rel(dx=0.0, dy=0.0, dz=0.0, rot=None, elbow=0.0):
     m = np.eye(4)

@@ -11,7 +11,7 @@ from acti_motion.arm.core import ArmCore
 from acti_motion.executor import MotionExecutor
 from acti_motion.replies import ReturnCode as R
 from acti_sim.world import World
-from arm_fixtures import IDENTITY, arm  # noqa: F401
+from arm_fixtures import IDENTITY, arm, rest  # noqa: F401
 from sim_fixtures import executor, run_until  # noqa: F401
 from trajectory_check import ArmTrace
 
@@ -28,11 +28,6 @@ def trace(executor, arm):  # noqa: F811
 def steps(executor, n):  # noqa: F811
     for _ in range(n):
         executor.step()
-
-
-def rest(executor, arm, max_seconds=15.0):  # noqa: F811
-    run_until(executor, lambda: not arm.device.busy, max_seconds)
-    steps(executor, 10)
 
 
 class HeldPlanner:
