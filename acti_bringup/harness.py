@@ -126,25 +126,25 @@ class Actions:
         self.client = ActionClient(ros.node, action_type, name)
         assert self.client.wait_for_server(timeout_sec=30.0)
 
-    def spin(self, future, timeout: float = ACTION_TIMEOUT):
+    def spin(self, future: Any, timeout: float = ACTION_TIMEOUT) -> Any:
         assert self.ros.wait(future, timeout), "no answer in time"
         return future.result()
 
-    def offer(self, feedback=None, **fields):
+    def offer(self, feedback: Callable[[Any], None] | None = None, **fields: Any) -> Any:
         """The goal handle, accepted or not."""
         return self.spin(self.client.send_goal_async(self.type.Goal(**fields),
                                                      feedback_callback=feedback))
 
-    def send(self, feedback=None, **fields):
+    def send(self, feedback: Callable[[Any], None] | None = None, **fields: Any) -> Any:
         handle = self.offer(feedback, **fields)
         assert handle.accepted
         return handle
 
-    def result(self, handle):
+    def result(self, handle: Any) -> tuple[int, Any]:
         out = self.spin(handle.get_result_async())
         return out.status, out.result
 
-    def cancel(self, handle) -> None:
+    def cancel(self, handle: Any) -> None:
         self.spin(handle.cancel_goal_async())
 
 

@@ -17,19 +17,35 @@ whole path (`unblended`), never at the seam.
 """
 from __future__ import annotations
 
-from typing import Callable
+from typing import TYPE_CHECKING, Callable, Protocol
 
 import numpy as np
 
 from acti_motion.executor import Device
 from acti_motion.arm.trajectories import ArmSetpoint
 
+if TYPE_CHECKING:
+    from acti_sim.world import World
+
 ARM_MOVES = ("joint", "cartesian")
 SEAM_MARGIN = 0.02         # s: a running move is not cut closer than this to where it is now
 OVERLAP_STEPS = 24         # candidate overlaps tried, longest first
 
 
-def joint_velocity(motion, t: float) -> np.ndarray:
+class ArmMove(Protocol):
+    """An arm move the device runs: an `ArmMotion` as planned, or one cut (`Truncated`) or
+    blended (`Blend`) here."""
+    duration: float
+    ramp: float
+    kind: str
+    limits_checked: np.ndarray | None
+
+    def at(self, t: float) -> ArmSetpoint: ...
+
+    def apply(self, world: World, t: float, rate: float) -> None: ...
+
+
+def joint_velocity(motion: ArmMove, t: float) -> np.ndarray:
     """dq/dt (rad/s) of a motion at time t."""
     velocity = getattr(motion, "velocity", None)
     if velocity is not None:
@@ -41,7 +57,7 @@ def joint_velocity(motion, t: float) -> np.ndarray:
 class Truncated:
     """A move cut short at `duration` (it hands over to the next one there)."""
 
-    def __init__(self, whole, duration: float) -> None:
+    def __init__(self, whole: ArmMove, duration: float) -> None:
         self.unblended = whole
         self.duration = duration
         self.ramp, self.kind = whole.ramp, whole.kind
@@ -53,7 +69,7 @@ class Truncated:
     def velocity(self, t: float) -> np.ndarray:
         return joint_velocity(self.unblended, min(t, self.duration))
 
-    def apply(self, world, t: float, rate: float) -> None:
+    def apply(self, world: World, t: float, rate: float) -> None:
         self.unblended.apply(world, min(t, self.duration), rate)
 
 
@@ -61,7 +77,7 @@ class Blend:
     """Move `nxt` started `head` seconds before the end of `prev`: for t < head the set-point is
     nxt(t) + prev(T − head + t) − prev(T), the velocities add."""
 
-    def __init__(self, prev, head: float, nxt) -> None:
+    def __init__(self, prev: ArmMove, head: float, nxt: ArmMove) -> None:
         self.prev, self.head, self.next = prev, head, nxt
         self.t0 = prev.duration - head
         self._seam = prev.at(prev.duration).joints
@@ -81,15 +97,15 @@ class Blend:
         v = joint_velocity(self.next, t)
         return v + joint_velocity(self.prev, self.t0 + t) if t < self.head else v
 
-    def apply(self, world, t: float, rate: float) -> None:
+    def apply(self, world: World, t: float, rate: float) -> None:
         if t >= self.head:
             self.next.apply(world, t, rate)
         else:
             world.set_arm_targets(self.at(t).joints, rate * self.velocity(t))
 
 
-def overlap(prev, nxt, radius: float, position: Callable[[np.ndarray], np.ndarray],
-            earliest: float = 0.0) -> float:
+def overlap(prev: ArmMove, nxt: ArmMove, radius: float,
+            position: Callable[[np.ndarray], np.ndarray], earliest: float = 0.0) -> float:
     """The blend time τ (s) of `nxt` after `prev` for the approach radius `radius` (m); 0 when
     they cannot overlap. `earliest`: prev may not be cut before this time (where it is now)."""
     room = prev.duration - getattr(prev, "head", 0.0)

@@ -20,7 +20,7 @@ import functools
 import logging
 import math
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Callable, Protocol, TypeGuard
 
 import numpy as np
 import pinocchio as pin
@@ -124,7 +124,7 @@ class _PathParameter:
     """s itself as a one-axis path: ParametrizeConstAccel over it yields s(t) and ds/dt."""
     dof = 1
 
-    def __call__(self, ss, order: int = 0) -> np.ndarray:
+    def __call__(self, ss: float | np.ndarray, order: int = 0) -> np.ndarray:
         ss = np.atleast_1d(np.asarray(ss, float))
         return (ss if order == 0 else np.full(len(ss), 1.0 if order == 1 else 0.0))[:, None]
 
@@ -171,6 +171,17 @@ class ArmMotion:
 
 
 # --- Cartesian paths of the control point (robot frame, m) ---------------------------------------
+class CartesianPath(Protocol):
+    """What the planner takes as a path: the pose (4×4) and the position at progress s ∈ [0, 1],
+    its length (m) and its rotation angle (rad). `LinePath` and `ArcPath`, or a program's path."""
+    length: float
+    angle: float
+
+    def pose(self, s: float) -> np.ndarray: ...
+
+    def position(self, s: float) -> np.ndarray: ...
+
+
 class LinePath:
     """Straight line and rotation geodesic, both linear in s."""
 
@@ -231,20 +242,20 @@ class ArcPath(LinePath):
         return self.center + rotate_many(axes, ss * self.sweep, self._r0)
 
 
-def _own(path) -> bool:
+def _own(path: CartesianPath) -> TypeGuard[LinePath]:
     """A path of this module: poses at once, and `length` is the control point's path length
     (the programs' paths define only `pose`, and their length is the tool point's)."""
     return type(path) in (LinePath, ArcPath)
 
 
-def poses_along(path, ss: np.ndarray) -> np.ndarray:
+def poses_along(path: CartesianPath, ss: np.ndarray) -> np.ndarray:
     """Poses of `path` at each s: at once for the paths of this module, one by one for others."""
     if _own(path):
         return path.poses(ss)
     return np.array([path.pose(s) for s in ss])
 
 
-def positions_along(path, ss: np.ndarray) -> np.ndarray:
+def positions_along(path: CartesianPath, ss: np.ndarray) -> np.ndarray:
     """Positions of `path` at each s (N×3), as `poses_along`."""
     if _own(path):
         return path.positions(ss)
@@ -275,8 +286,9 @@ class CartesianPlanner:
     def __init__(self, kin: ArmKinematics) -> None:
         self.kin = kin
 
-    def plan(self, path: LinePath, frames: Frames, start_q: np.ndarray, limits: CartesianLimits,
-             *, psi: float | None = None, turn: float = 0.0) -> CartesianPlan:
+    def plan(self, path: CartesianPath, frames: Frames, start_q: np.ndarray,
+             limits: CartesianLimits, *, psi: float | None = None,
+             turn: float = 0.0) -> CartesianPlan:
         """Joint spline and timing that move the control point along `path` (robot frame) while
         the elbow, carried along without twist, turns by `turn` (rad) or, when `psi` is given,
         by what it takes to end at the arm angle `psi`."""
@@ -291,7 +303,7 @@ class CartesianPlanner:
         timing = time_optimal(spline.ss, spline.qs, extents, limits)
         return CartesianPlan(spline, timing, True)
 
-    def check_length(self, path, frames: Frames) -> None:
+    def check_length(self, path: CartesianPath, frames: Frames) -> None:
         """Unreachable when `path` (a line or arc of this module) is longer than any path within
         the arm's reach: every control point lies within reach + hand + the control-point
         offset of the shoulder, and no line or arc inside a ball of radius r is longer than 2πr.
@@ -304,7 +316,8 @@ class CartesianPlanner:
                               f"{2 * math.pi * radius * 1e3:.0f} mm")
 
     # --- the elbow along the path: transported without twist, plus an even turn to the target ---
-    def _elbow_plan(self, path, to_flange, start_q, psi, turn) -> "_ElbowPlan":
+    def _elbow_plan(self, path: CartesianPath, to_flange: Callable[[np.ndarray], np.ndarray],
+                    start_q: np.ndarray, psi: float | None, turn: float) -> "_ElbowPlan":
         kin = self.kin
         grid = np.linspace(0.0, 1.0, 1 + min(128, max(16, math.ceil(path.length / 0.005),
                                                       math.ceil(path.angle / 0.02))))
@@ -322,7 +335,8 @@ class CartesianPlanner:
             turn = wrap(psi - kin.angle_of(us[-1], ns[-1]))
         return _ElbowPlan(grid, ns, turn)
 
-    def _sample(self, path, frames, start_q, elbow) -> SplineJointPath:
+    def _sample(self, path: CartesianPath, frames: Frames, start_q: np.ndarray,
+                elbow: _ElbowPlan) -> SplineJointPath:
         kin, ik = self.kin, _PathIK(self.kin, path, frames, elbow)
         count = 1 + max(8, math.ceil(path.length / 0.02), math.ceil(path.angle / 0.1),
                         math.ceil(abs(elbow.turn) / 0.1))
@@ -382,7 +396,8 @@ class _PathIK:
     decides alone, else one by one with `ArmKinematics.solve` (same answers, and the reason
     when there is none)."""
 
-    def __init__(self, kin: ArmKinematics, path, frames: Frames, elbow: _ElbowPlan) -> None:
+    def __init__(self, kin: ArmKinematics, path: CartesianPath, frames: Frames,
+                 elbow: _ElbowPlan) -> None:
         self.kin, self.path, self.frames, self.elbow = kin, path, frames, elbow
 
     def _targets(self, ss: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -445,7 +460,8 @@ def _limit_constraints(vlim: tuple[float, ...], alim: tuple[float, ...]) -> list
 
 
 def _insert(ss: np.ndarray, qs: np.ndarray, where: np.ndarray,
-            solve) -> tuple[np.ndarray, np.ndarray]:
+            solve: Callable[[np.ndarray, np.ndarray], np.ndarray]
+            ) -> tuple[np.ndarray, np.ndarray]:
     """Insert the midpoints of the intervals `where`, solved from their left samples."""
     mids = (ss[where] + ss[where + 1]) / 2
     return np.insert(ss, where + 1, mids), np.insert(qs, where + 1, solve(mids, qs[where]), axis=0)

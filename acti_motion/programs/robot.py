@@ -21,7 +21,7 @@ import sys
 import threading
 import time
 from dataclasses import dataclass
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
@@ -39,8 +39,12 @@ from strolic.errors import ExceptionKind as K, StrolicError, fail
 from strolic.functions.args import integer_value, pop_many, pop_num, pop_of
 from strolic.functions.geometry import matrix_of, pose_of, pose_parts
 from strolic.host import Host, MemoryIO
-from strolic.process import WAIT, State
+from strolic.process import WAIT, Process, State
 from strolic.values import array_elements
+
+if TYPE_CHECKING:
+    from strolic.opcodes import Opcode
+    from strolic.vm import VM
 
 # error flags of the setting, motion and hand functions (0: no exception)
 FLAG_INVALID = 1        # a value out of its range, an undefined pose, a wrong count
@@ -68,6 +72,10 @@ STATUS_BITS = ("servo on", "moving", "alarm", "paused", "hand closed", "hand ope
 HAND_TOLERANCE_MM = 1.0
 CONFIGURATION_BITS = 0b111
 PLANES = {1: 2, 2: 0, 3: 1}    # CMOVE1 plane → its normal axis: xy → z, yz → x, zx → y
+
+# a robot-control function of `FUNCTIONS`, called unbound with the host: it returns WAIT when
+# the process must wait (the VM calls it again later), else None
+Handler = Callable[["RobotHost", "VM", Process], object]
 
 
 @dataclass
@@ -157,7 +165,7 @@ class CirclePath(LinePath):
         return T
 
 
-def _wait_key(proc) -> tuple:
+def _wait_key(proc: Process) -> tuple:
     return id(proc), id(proc.frame), proc.frame.pc
 
 
@@ -170,7 +178,7 @@ def _shown_line(text: str) -> str:
     return text
 
 
-def _push_flag(proc, code: int) -> None:
+def _push_flag(proc: Process, code: int) -> None:
     proc.push(Num(I2, code))
 
 
@@ -212,7 +220,7 @@ class RobotHost(Host):
         self._last_check = self.now()
 
     # === the VM's hooks =========================================================================
-    def call(self, vm, proc, opcode):
+    def call(self, vm: VM, proc: Process, opcode: Opcode) -> object:
         method = FUNCTIONS.get(opcode.mnemonic)
         if method is None:
             return super().call(vm, proc, opcode)
@@ -246,7 +254,7 @@ class RobotHost(Host):
                 wall = (end - self.now()) / factor if factor > 0 else 0.0
                 self.cancel_event.wait(min(max(wall, 0.0005), 0.05))
 
-    def check(self, vm) -> None:
+    def check(self, vm: VM) -> None:
         if self.cancel_event.is_set():
             raise fail(K.STOPPED, "the run was canceled")
         now = self.now()
@@ -255,7 +263,7 @@ class RobotHost(Host):
         self._last_check = now
         self._collect()
 
-    def stop(self, error) -> None:
+    def stop(self, error: StrolicError) -> None:
         """The program stopped on an exception: the arm decelerates and its queue is discarded."""
         self.state = "stopping"
         self.arm.stop_motion(reason=f"the program's end: {error}")
@@ -351,7 +359,7 @@ class RobotHost(Host):
         except StrolicError:
             pass
 
-    def wait_motions(self, vm) -> None:
+    def wait_motions(self, vm: VM) -> None:
         """After the program's end: wait until its motions are over (exceptions as `check`)."""
         self.state = "finishing motions"
         self.check(vm)
@@ -369,11 +377,11 @@ class RobotHost(Host):
         hand = self.hands.get(self.hand)
         return hand.tool if hand is not None and hand.tool is not None else np.eye(4)
 
-    def _interrupted(self, vm) -> bool:
+    def _interrupted(self, vm: VM) -> bool:
         return any(isinstance(k, str) and p.state is not State.DONE
                    for k, p in vm.processes.items())
 
-    def _flag(self, proc, name: str, error: Flag | None) -> None:
+    def _flag(self, proc: Process, name: str, error: Flag | None) -> None:
         if error is not None:
             self.console(f"{name}: error flag {error.code}: {error.reason}")
         _push_flag(proc, 0 if error is None else error.code)
@@ -387,7 +395,7 @@ class RobotHost(Host):
         minimum = arm.min_accel_time_joint if joint else arm.min_accel_time_cartesian
         default = arm.accel_time_joint if joint else arm.accel_time_cartesian
 
-        def of(setting):
+        def of(setting: tuple[str, float] | None) -> float:
             if setting is None:
                 return default
             how, value = setting
@@ -426,7 +434,7 @@ class RobotHost(Host):
             raise Flag(FLAG_INVALID, "undefined pose: the elbow angle is not finite")
         return Target(T, configuration & CONFIGURATION_BITS, elbow)
 
-    def _targets(self, item) -> list[Target]:
+    def _targets(self, item: object) -> list[Target]:
         """A Pm or an Ar of Pm (a pose sequence) as targets."""
         if isinstance(item, Pose):
             return [self.target_of(item)]
@@ -438,7 +446,7 @@ class RobotHost(Host):
         raise fail(K.TYPE_MISMATCH, "a pose (Pm) or a pose sequence (Ar of Pm) expected")
 
     @staticmethod
-    def _count_of(item) -> int:
+    def _count_of(item: object) -> int:
         if isinstance(item, Array) and item.element.tag == POSE:
             return max(1, len(item.data) // max(1, item.element.element_size()))
         return 1
@@ -529,8 +537,8 @@ class RobotHost(Host):
         ratio = 100.0 * opening_mm / self.max_opening
         self._submit(lambda: self.arm.queue_gripper(ratio, label))
 
-    def _move(self, vm, proc, name: str, nargs: int, count: Callable[[list], int],
-              run: Callable[[list], None], ratio: float, setting: str):
+    def _move(self, vm: VM, proc: Process, name: str, nargs: int, count: Callable[[list], int],
+              run: Callable[[list], None], ratio: float, setting: str) -> object:
         """The frame of every motion command: its `nargs` arguments stay on the stack while the
         queue has no room for its motions (the program waits); then they are taken and the
         motions queued; the flag tells how it went."""
@@ -548,7 +556,7 @@ class RobotHost(Host):
         self._flag(proc, name, None)
 
     # === ED00–ED05: speeds and accelerations =====================================================
-    def _setting(self, proc, name: str, valid: Callable[[float], str | None],
+    def _setting(self, proc: Process, name: str, valid: Callable[[float], str | None],
                  apply: Callable[[float], None]) -> None:
         value = float(pop_num(proc).value)
         why = valid(value)
@@ -557,7 +565,8 @@ class RobotHost(Host):
         self._flag(proc, name, None if why is None else Flag(FLAG_INVALID, why))
 
     @staticmethod
-    def _within(low: float, high: float, unit: str, low_open: bool = False):
+    def _within(low: float, high: float, unit: str,
+                low_open: bool = False) -> Callable[[float], str | None]:
         def valid(value: float) -> str | None:
             if (value <= low if low_open else value < low) or value > high:
                 bracket = "(" if low_open else "["
@@ -565,46 +574,46 @@ class RobotHost(Host):
             return None
         return valid
 
-    def jspeed_(self, vm, proc) -> None:
+    def jspeed_(self, vm: VM, proc: Process) -> None:
         self._setting(proc, "JSPEED", self._within(0.0, 100.0, "%"),
                       lambda v: setattr(self, "jspeed", v))
 
-    def speed_(self, vm, proc) -> None:
+    def speed_(self, vm: VM, proc: Process) -> None:
         self._setting(proc, "SPEED", self._within(0.0, self.arm.max_speed_cartesian[0], "mm/s"),
                       lambda v: setattr(self, "speed", v))
 
-    def _accel_percent(self, proc, name: str, attribute: str) -> None:
+    def _accel_percent(self, proc: Process, name: str, attribute: str) -> None:
         self._setting(proc, name, self._within(0.0, 100.0, "%", low_open=True),
                       lambda v: setattr(self, attribute, ("percent", v)))
 
-    def _accel_time(self, proc, name: str, attribute: str) -> None:
+    def _accel_time(self, proc: Process, name: str, attribute: str) -> None:
         minimum = max(self.arm.min_accel_time_joint, self.arm.min_accel_time_cartesian)
         self._setting(proc, name, self._within(minimum, MAX_RAMP, "s"),
                       lambda v: setattr(self, attribute, ("time", v)))
 
-    def accel1(self, vm, proc) -> None:
+    def accel1(self, vm: VM, proc: Process) -> None:
         self._accel_percent(proc, "ACCEL1", "accel")
 
-    def accel2(self, vm, proc) -> None:
+    def accel2(self, vm: VM, proc: Process) -> None:
         self._accel_time(proc, "ACCEL2", "accel")
 
-    def decel1(self, vm, proc) -> None:
+    def decel1(self, vm: VM, proc: Process) -> None:
         self._accel_percent(proc, "DECEL1", "decel")
 
-    def decel2(self, vm, proc) -> None:
+    def decel2(self, vm: VM, proc: Process) -> None:
         self._accel_time(proc, "DECEL2", "decel")
 
     # === ED06–ED0B: configuration ===============================================================
-    def sconf(self, vm, proc) -> None:
+    def sconf(self, vm: VM, proc: Process) -> None:
         vm.configuration = integer_value(pop_num(proc)) & CONFIGURATION_BITS
         _push_flag(proc, 0)
 
-    def sconf2(self, vm, proc) -> None:
+    def sconf2(self, vm: VM, proc: Process) -> None:
         """No extended configuration bits are defined for this arm: ignored."""
         pop_num(proc)
         _push_flag(proc, 0)
 
-    def sconf3(self, vm, proc) -> None:
+    def sconf3(self, vm: VM, proc: Process) -> None:
         """Number 1: the elbow (arm) angle in degrees that PNT gives; other numbers ignored."""
         value = float(pop_num(proc).value)
         number = integer_value(pop_num(proc))
@@ -612,25 +621,25 @@ class RobotHost(Host):
             vm.elbow = math.remainder(value, 360.0)
         _push_flag(proc, 0)
 
-    def gconf(self, vm, proc) -> None:
+    def gconf(self, vm: VM, proc: Process) -> None:
         proc.push(Num(I2, vm.configuration & CONFIGURATION_BITS))
 
-    def gconf2(self, vm, proc) -> None:
+    def gconf2(self, vm: VM, proc: Process) -> None:
         proc.push(Num(I2, 0))
 
-    def gconf3(self, vm, proc) -> None:
+    def gconf3(self, vm: VM, proc: Process) -> None:
         number = integer_value(pop_num(proc))
         proc.push(make_real(R8, vm.elbow) if number == 1 else Num(I2, 0))
 
     # === ED0C–ED10: current state, calibration, pause, delay =====================================
-    def here(self, vm, proc) -> None:
+    def here(self, vm: VM, proc: Process) -> None:
         proc.push(self.hand_pose(self.arm.feedback_joints))
 
-    def jhere(self, vm, proc) -> None:
+    def jhere(self, vm: VM, proc: Process) -> None:
         values = np.degrees(self.arm.feedback_joints)
         proc.push(Array(TagHead(R4), struct.pack(f">{len(values)}f", *values)))
 
-    def calib(self, vm, proc):
+    def calib(self, vm: VM, proc: Process) -> object:
         """A joint move to the home (calibration) position at the JSPEED, waited for; a refusal
         is an exception (CALIB has no flag)."""
         key = _wait_key(proc)
@@ -652,7 +661,7 @@ class RobotHost(Host):
         del self._waits[key]
         return None
 
-    def pause(self, vm, proc) -> None:
+    def pause(self, vm: VM, proc: Process) -> None:
         """Shows the message, pauses the arm (it decelerates and holds, its queue kept) and
         waits until the arm is resumed (the resume service), then pushes 0."""
         message = pop_of(proc, Str, "a message (St)").data.decode("utf-8", "replace")
@@ -681,7 +690,7 @@ class RobotHost(Host):
                        "an alarm; only resume goes on)")
         _push_flag(proc, 0)
 
-    def delay(self, vm, proc):
+    def delay(self, vm: VM, proc: Process) -> object:
         """DELAY t (s): the count stands still while an interrupt action or a PAUSE runs."""
         seconds = float(_number(proc.peek()).value)   # stays on the stack while waiting
         if not 0.0 <= seconds <= MAX_DELAY:
@@ -699,7 +708,8 @@ class RobotHost(Host):
         return WAIT
 
     # === ED11–ED19: motions ======================================================================
-    def _poses_move(self, vm, proc, name: str, relative: bool, joint: bool):
+    def _poses_move(self, vm: VM, proc: Process, name: str, relative: bool,
+                    joint: bool) -> object:
         def run(args: list) -> None:
             targets = self._targets(args[0])
             if relative:
@@ -714,19 +724,19 @@ class RobotHost(Host):
         return self._move(vm, proc, name, 1, lambda a: self._count_of(a[0]), run,
                           self._cartesian_ratio(), "SPEED")
 
-    def ajmove(self, vm, proc):
+    def ajmove(self, vm: VM, proc: Process) -> object:
         return self._poses_move(vm, proc, "AJMOVE", relative=False, joint=True)
 
-    def ijmove(self, vm, proc):
+    def ijmove(self, vm: VM, proc: Process) -> object:
         return self._poses_move(vm, proc, "IJMOVE", relative=True, joint=True)
 
-    def almove(self, vm, proc):
+    def almove(self, vm: VM, proc: Process) -> object:
         return self._poses_move(vm, proc, "ALMOVE", relative=False, joint=False)
 
-    def ilmove(self, vm, proc):
+    def ilmove(self, vm: VM, proc: Process) -> object:
         return self._poses_move(vm, proc, "ILMOVE", relative=True, joint=False)
 
-    def hmove(self, vm, proc):
+    def hmove(self, vm: VM, proc: Process) -> object:
         """Moves expressed in the hand's tool frame where the command starts: T_start · T(a)."""
         def run(args: list) -> None:
             _, start = self._start()
@@ -736,7 +746,7 @@ class RobotHost(Host):
         return self._move(vm, proc, "HMOVE", 1, lambda a: self._count_of(a[0]), run,
                           self._cartesian_ratio(), "SPEED")
 
-    def cmove1(self, vm, proc):
+    def cmove1(self, vm: VM, proc: Process) -> object:
         """a b c d: plane a (1 xy, 2 yz, 3 zx), angle b (degree, ≥ 0 counter-clockwise seen
         from the plane's normal axis), centre c (its position, moved into the plane through
         the start), orientation d (1 turns with the arc, 2 kept, 3 ends at c's)."""
@@ -771,7 +781,7 @@ class RobotHost(Host):
                                      "CMOVE1", None)
         return self._move(vm, proc, "CMOVE1", 4, lambda a: 1, run, self._cartesian_ratio(), "SPEED")
 
-    def cmove3(self, vm, proc):
+    def cmove3(self, vm: VM, proc: Process) -> object:
         """a b: the arc from the start through a's position to b (b's orientation and elbow)."""
         def run(args: list) -> None:
             via, target = (self.target_of(_pose(item)) for item in args)
@@ -790,7 +800,7 @@ class RobotHost(Host):
                                      math.radians(target.elbow))
         return self._move(vm, proc, "CMOVE3", 2, lambda a: 1, run, self._cartesian_ratio(), "SPEED")
 
-    def _joints_of(self, item) -> np.ndarray:
+    def _joints_of(self, item: object) -> np.ndarray:
         if not isinstance(item, Array) or item.element.tag not in NUMERIC_TAGS:
             raise fail(K.TYPE_MISMATCH, "an array of numbers (the joint values) expected")
         values = np.array([float(v.value) for v in array_elements(item)])
@@ -799,27 +809,27 @@ class RobotHost(Host):
                                      f"{self.arm.axis_count}")
         return np.radians(values)
 
-    def adrive(self, vm, proc):
+    def adrive(self, vm: VM, proc: Process) -> object:
         def run(args: list) -> None:
             goal = self._joints_of(args[0])
             self._joint_move(lambda start: goal, "ADRIVE")
         return self._move(vm, proc, "ADRIVE", 1, lambda a: 1, run, self.jspeed, "JSPEED")
 
-    def idrive(self, vm, proc):
+    def idrive(self, vm: VM, proc: Process) -> object:
         def run(args: list) -> None:
             delta = self._joints_of(args[0])
             self._joint_move(lambda start: start.joints + delta, "IDRIVE")
         return self._move(vm, proc, "IDRIVE", 1, lambda a: 1, run, self.jspeed, "JSPEED")
 
     # === ED1A–ED1D: approach accuracy, completion ================================================
-    def sacc(self, vm, proc) -> None:
+    def sacc(self, vm: VM, proc: Process) -> None:
         self._setting(proc, "SACC", self._within(0.0, MAX_ACCURACY, "mm"),
                       lambda v: setattr(self, "accuracy", v))
 
-    def gacc(self, vm, proc) -> None:
+    def gacc(self, vm: VM, proc: Process) -> None:
         proc.push(make_real(R4, self.accuracy))
 
-    def wait(self, vm, proc):
+    def wait(self, vm: VM, proc: Process) -> object:
         """$WAIT t: t s at most (t < 0: no limit, 0: look once); 0 over, 1/2/3 still moving
         (robot / hand / both) when the time ran out, < 0 an abnormal end."""
         seconds = float(_number(proc.peek()).value)
@@ -832,10 +842,10 @@ class RobotHost(Host):
         proc.timed = None
         _push_flag(proc, status)
 
-    def _vm_wait(self, vm, proc, seconds: float):
+    def _vm_wait(self, vm: VM, proc: Process, seconds: float) -> object:
         return vm.timed_wait(proc, seconds, POLL)
 
-    def done(self, vm, proc) -> None:
+    def done(self, vm: VM, proc: Process) -> None:
         """$DONE; while something moves it lets one control cycle pass (a program that polls
         $DONE in a loop does not keep the processor from the simulation)."""
         status = self.motion_status()
@@ -850,7 +860,8 @@ class RobotHost(Host):
             raise Flag(FLAG_HAND, f"hand {self.hand} is not defined")
         return hand
 
-    def _hand_motion(self, vm, proc, name: str, opening: Callable[[Hand], float]):
+    def _hand_motion(self, vm: VM, proc: Process, name: str,
+                     opening: Callable[[Hand], float]) -> object:
         try:
             self._ready(1.0, "")
             if not self._room(1) or not self._queue_together(
@@ -862,14 +873,14 @@ class RobotHost(Host):
         proc.timed = None
         return None
 
-    def handopen(self, vm, proc):
+    def handopen(self, vm: VM, proc: Process) -> object:
         return self._hand_motion(vm, proc, "HANDOPEN", lambda h: self.max_opening
                                  if h.open_mm is None else h.open_mm)
 
-    def handclose(self, vm, proc):
+    def handclose(self, vm: VM, proc: Process) -> object:
         return self._hand_motion(vm, proc, "HANDCLOSE", lambda h: h.close_mm)
 
-    def grasp(self, vm, proc):
+    def grasp(self, vm: VM, proc: Process) -> object:
         """a1 1 GRASP: the opening a1 (mm) of the gripper."""
         count = integer_value(_number(proc.peek()))
 
@@ -891,7 +902,7 @@ class RobotHost(Host):
             raise fail(K.STACK_UNDERFLOW, f"{count} parameters wanted")
         return self._move(vm, proc, "GRASP", count + 1, lambda a: 1, run, 1.0, "")
 
-    def handdef(self, vm, proc) -> None:
+    def handdef(self, vm: VM, proc: Process) -> None:
         """a1 … an n b: hand b; parameters (all optional, in this order): the tool frame (Trn,
         mm, seen from the control point), the HANDOPEN and HANDCLOSE openings (mm)."""
         number = integer_value(_number(proc.pop()))
@@ -932,7 +943,7 @@ class RobotHost(Host):
             hand.close_mm = openings[1]
         return hand
 
-    def handref(self, vm, proc) -> None:
+    def handref(self, vm: VM, proc: Process) -> None:
         hand = self.hands.get(integer_value(_number(proc.pop())))
         if hand is None:
             proc.push(Num(I2, -1))
@@ -940,7 +951,7 @@ class RobotHost(Host):
         proc.stack.extend(hand.params)
         proc.push(Num(I2, len(hand.params)))
 
-    def handchg(self, vm, proc) -> None:
+    def handchg(self, vm: VM, proc: Process) -> None:
         number = integer_value(_number(proc.pop()))
         if number not in self.hands:
             return self._flag(proc, "HANDCHG", Flag(FLAG_HAND, f"hand {number} is not defined"))
@@ -958,19 +969,19 @@ def configured(q: np.ndarray, configuration: int) -> np.ndarray:
     return ref
 
 
-def _number(item) -> Num:
+def _number(item: object) -> Num:
     if not isinstance(item, Num):
         raise fail(K.TYPE_MISMATCH, "a number expected")
     return item
 
 
-def _pose(item) -> Pose:
+def _pose(item: object) -> Pose:
     if not isinstance(item, Pose):
         raise fail(K.TYPE_MISMATCH, "a pose (Pm) expected")
     return item
 
 
-FUNCTIONS: dict[str, Callable] = {
+FUNCTIONS: dict[str, Handler] = {
     "JSPEED": RobotHost.jspeed_, "SPEED": RobotHost.speed_,
     "ACCEL1": RobotHost.accel1, "ACCEL2": RobotHost.accel2,
     "DECEL1": RobotHost.decel1, "DECEL2": RobotHost.decel2,

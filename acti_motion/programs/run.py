@@ -123,7 +123,8 @@ class ProgramRun:
     """A program run on `arm`; `step` (tests) advances the simulation while the program waits."""
 
     def __init__(self, arm: ArmCore, program: bytes | str, *, io: MemoryIO | None = None,
-                 step=None, defaults: ProgramDefaults | None = None, budget: int | None = None,
+                 step: Callable[[], None] | None = None,
+                 defaults: ProgramDefaults | None = None, budget: int | None = None,
                  echo: bool = False) -> None:
         self.arm = arm
         self.program = program

@@ -47,8 +47,13 @@ class CurvePlan:
     via_times: list[float]
 
 
+# a geometric path's dense samples (arc length s, x, y, heading) and the arc length of each point
+CurveGeometry = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[float]]
+
+
 def time_optimal(s: np.ndarray, heading: np.ndarray, limits: tuple[float, float, float, float],
-                 v0: float = 0.0, grid_step: float = GRID_STEP, grid_max: int = GRID_MAX):
+                 v0: float = 0.0, grid_step: float = GRID_STEP,
+                 grid_max: int = GRID_MAX) -> toppra.interpolator.AbstractGeometricPath | None:
     """TOPP-RA over the path (s, theta(s)) with the drive's bounds, from speed v0 to rest.
     A start faster than v_max (the velocity setting was lowered) is let down at LET_DOWN · a_max.
     The trajectory (callable t → [s, theta], and its derivatives), or None when infeasible."""
@@ -72,7 +77,8 @@ def time_optimal(s: np.ndarray, heading: np.ndarray, limits: tuple[float, float,
     return instance.compute_trajectory(sd_start=v0, sd_end=0.0)
 
 
-def spline_through(start: Pose2D, points: Sequence[tuple[float, float]], curvature: float = 0.0):
+def spline_through(start: Pose2D, points: Sequence[tuple[float, float]],
+                   curvature: float = 0.0) -> CurveGeometry | None:
     """Dense samples of the quintic spline from the start position through `points`, leaving
     along the start heading with the given curvature (1/m; so the yaw rate goes on without a
     jump where it takes over from a running path) and ending straight: (arc length s, x, y,
