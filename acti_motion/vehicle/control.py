@@ -14,7 +14,7 @@ from acti_motion.executor import STOPPED, Device
 from acti_motion.replies import Reply
 from acti_motion.vehicle.alarms import Alarm, AlarmCode, Alarms, AlarmType, Kind
 from acti_motion.vehicle.paths import BrakeMotion, Odometry
-from acti_motion.vehicle.refusals import VehicleRefused, command, invalid, query
+from acti_motion.vehicle.refusals import VehicleRefused, command, invalid, query, si_pair
 from acti_motion.vehicle.states import SERVO_ON, STATE_STRINGS, VehicleState
 
 IF_VERSION = "RTC VehicleService interface: ver.2.0.0"
@@ -255,7 +255,7 @@ class Control:
         t = device.t
         now, later = twist(t), twist(t + dt)
         ramp = 0.02
-        for i, a in enumerate((accel[0] / 1000.0, math.radians(accel[1]))):
+        for i, a in enumerate(si_pair(accel)):
             change = (abs(later[i]) - abs(now[i])) / dt
             adds = max(0.0, change if up else -change)
             speed = abs(now[i])
@@ -285,6 +285,6 @@ class Control:
     def _halt(self, reason: str) -> None:
         """Give up the plan at once and brake the wheels at the maximum acceleration."""
         c = self.config
-        decel = (c.accel_limit_translation / 1000.0, math.radians(c.accel_limit_rotation))
+        decel = si_pair((c.accel_limit_translation, c.accel_limit_rotation))
         self.device.halt(self.odometry.pose, reason,
                          then=(BrakeMotion(self.odometry, decel), "brake"))

@@ -19,7 +19,7 @@ from acti_motion.vehicle.cruise import CruiseMotion, transition_to
 from acti_motion.vehicle.paths import (Path, Pose2D, TrackedBaseMotion, arc, line, straight_to, turn,
                                        velocity_path)
 from acti_motion.vehicle.refusals import (Discarded, VehicleRefused, bounded_pair, finite_pose, invalid,
-                                          planned)
+                                          planned, si_pair)
 from acti_motion.vehicle.sensing import VELOCITY_DRIVEN
 from acti_motion.vehicle.states import IDLE, SERVO_ON, STATE_STRINGS, VehicleState
 
@@ -240,9 +240,8 @@ class Planning:
             if abs(value) > limit:
                 raise invalid(f"{name} is {value:.10g} {unit}: the unit's limit is {limit:g} {unit}")
         self._require(SERVO_ON, "move_jog")
-        (at, ar) = self.acceleration
-        return self._drive((vx / 1000.0, math.radians(vth)), self.jog_timeout / 1000.0,
-                           (at / 1000.0, math.radians(ar)), "move_jog", take_over=True)
+        return self._drive(si_pair((vx, vth)), self.jog_timeout / 1000.0,
+                           si_pair(self.acceleration), "move_jog", take_over=True)
 
     def clamp_velocity(self, x_vel: float, theta_vel: float) -> tuple[float, float, bool] | None:
         """(x_vel mm/s, theta_vel degree/s) clamped to the unit's limits, and whether they were:
@@ -265,8 +264,8 @@ class Planning:
         if not on_off and cur is not None and cur.label == "joystick" and not self.device.paused:
             c = self.config
             try:
-                self._drive((0.0, 0.0), 0.0, (c.accel_limit_translation / 1000.0,
-                                              math.radians(c.accel_limit_rotation)), "joystick",
+                self._drive((0.0, 0.0), 0.0,
+                            si_pair((c.accel_limit_translation, c.accel_limit_rotation)), "joystick",
                             take_over=False, brake=True)
             except VehicleRefused:
                 pass    # the base outran every plan of the brake: the drive's deadman ends it
@@ -287,10 +286,10 @@ class Planning:
             def axis(i: int) -> float:
                 value = axes[i] if 0 <= i < len(axes) else 0.0
                 return min(1.0, max(-1.0, value)) if math.isfinite(value) else 0.0
-            (vt, vr), (at, ar) = self.velocity, self.acceleration
-            target = (axis(c.joy_axis_linear) * vt / 1000.0, math.radians(axis(c.joy_axis_angular) * vr))
+            vt, vr = self.velocity
+            target = si_pair((axis(c.joy_axis_linear) * vt, axis(c.joy_axis_angular) * vr))
             try:
-                self._drive(target, self.jog_timeout / 1000.0, (at / 1000.0, math.radians(ar)),
+                self._drive(target, self.jog_timeout / 1000.0, si_pair(self.acceleration),
                             "joystick", take_over=False)
             except Refused:
                 return False
@@ -359,8 +358,7 @@ class Planning:
     def _limits(self, velocity: tuple[float, float] | None = None,
                 acceleration: tuple[float, float] | None = None) -> tuple[float, float, float, float]:
         """The velocity and acceleration settings in SI: (v, w, a, alpha)."""
-        (vt, vr), (at, ar) = velocity or self.velocity, acceleration or self.acceleration
-        return vt / 1000.0, math.radians(vr), at / 1000.0, math.radians(ar)
+        return (*si_pair(velocity or self.velocity), *si_pair(acceleration or self.acceleration))
 
     def _splice_time(self, device: Device, motion: TrackedBaseMotion, attempt: int) -> float:
         """Motion time at which a plan made now takes over: a little ahead of the device, the

@@ -87,6 +87,11 @@ def bounded_pair(values: Any, lower: tuple[float, float], limits: tuple[float, f
     return out[0], out[1]
 
 
+def si_pair(pair: tuple[float, float]) -> tuple[float, float]:
+    """A (translation, rotation) pair of the spec's units (mm…, degree…) in SI (m…, rad…)."""
+    return pair[0] / 1000.0, math.radians(pair[1])
+
+
 def finite_pose(pos: Any, name: str = "pos") -> Pose2D:
     """A Position (mm, mm, degree) as a Pose2D (m, m, rad)."""
     x, y, theta = (finite_number(v, f"{name}.{f}") for v, f in zip(pos, ("x", "y", "theta")))

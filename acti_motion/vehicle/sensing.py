@@ -10,6 +10,7 @@ from typing import Any
 from acti_motion.executor import Device
 from acti_motion.vehicle.alarms import AlarmCode, Kind
 from acti_motion.vehicle.paths import BrakeMotion, Chain, velocity_path
+from acti_motion.vehicle.refusals import si_pair
 from acti_sim.world import World
 
 VELOCITY_DRIVEN = ("move_jog", "joystick")  # motions driven by a velocity, not a target
@@ -56,8 +57,7 @@ class Sensing:
         if (cur is None or cur.label not in VELOCITY_DRIVEN or self._deadman_fired == cur.id
                 or time.monotonic() < self._drive_deadline or device.stopping):
             return
-        (at, ar) = self.acceleration
-        accel = (at / 1000.0, math.radians(ar))
+        accel = si_pair(self.acceleration)
 
         def look(device: Device, attempt: int):
             if device.current is not cur:
