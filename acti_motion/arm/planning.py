@@ -1,0 +1,326 @@
+"""Planning and checking a move of the arm: what runs on the caller's thread before it is queued.
+
+A move operation checks its target at once (soft limits, reach: a full queue would hide it), then
+hands the device a plan, which the device calls on this same thread from the end of the last
+queued move; the motion is queued only if its path passes every check (soft limits, reach), with
+the settings read while planning. Planning takes milliseconds, so it runs on the thread of the
+service that asks (or of a STROLIC program), never on the simulation thread and never under the
+lock that the simulation, `stop` and `pause` take: none of them waits for it. `all_or_nothing`
+collects the moves of one thread (thread-local) and queues them together.
+A part of `ArmCore` (mixed in; uses its attributes).
+"""
+from __future__ import annotations
+
+import math
+import threading
+from contextlib import contextmanager
+from typing import Callable, Iterator
+
+import numpy as np
+
+from acti_motion.arm.kinematics import Unreachable, rotate_about
+from acti_motion.arm.poses import Frames, inverse
+from acti_motion.arm.trajectories import (ArmMotion, ArmSetpoint, CartesianLimits,
+                                          CartesianPlanner, LinearJointPath, LinePath,
+                                          positions_along)
+from acti_motion.profiles import Trapezoid
+from acti_motion.replies import Refused, Reply, ReturnCode, value_error
+
+R = ReturnCode
+
+REL_ELBOW_CLEARANCE = math.sin(math.radians(10.0))
+REACH_SAMPLES = 64                       # points of a CP path checked against the reach first
+MAX_CHECK_SAMPLES = 20000                # points of a CP path checked against the soft limits
+NEAR_LIMIT_MM = 1.0      # samples this close to a Cartesian soft limit: checked between, finer
+NEAR_LIMIT_DEG = 0.01    # the same for a joint soft limit along a CP path's joint spline
+
+
+def _near_limits_refined(ss: np.ndarray, values: np.ndarray, evaluate: Callable[[np.ndarray], np.ndarray],
+                         lower: np.ndarray, upper: np.ndarray, margin: float,
+                         count: int = 16) -> np.ndarray:
+    """`values` (rows at the path parameters ss) with `count` more rows, in order, inside every
+    interval that has an end within `margin` of a limit: what the path does between two samples
+    near a limit is checked too, as the run's watch, which samples every control period, would
+    see it (accepted moves tripped it by 1e-6° or 0.12 mm)."""
+    near = np.any((values <= lower + margin) | (values >= upper - margin), axis=1)
+    todo = np.flatnonzero(near[:-1] | near[1:])
+    if not len(todo):
+        return values
+    t = np.linspace(0.0, 1.0, count + 2)[1:-1]
+    extra = (ss[todo, None] + (ss[todo + 1] - ss[todo])[:, None] * t).ravel()
+    order = np.argsort(np.concatenate([ss, extra]), kind="stable")
+    return np.vstack([values, evaluate(extra)])[order]
+
+
+def _first_exit(values: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+                tol: float) -> tuple[int, int] | None:
+    """(sample, axis) where rows of `values` first go from inside [lower, upper] to outside,
+    or where the last row is outside; None when the path stays (or ends) inside."""
+    inside = (values >= lower - tol) & (values <= upper + tol)
+    if inside.all():                     # the usual case, at the least cost
+        return None
+    exits = np.argwhere(inside[:-1] & ~inside[1:])
+    if len(exits):
+        k, axis = exits[0]
+        return int(k) + 1, int(axis)
+    outside = np.flatnonzero(~inside[-1])
+    if len(outside):
+        return len(values) - 1, int(outside[0])
+    return None
+
+
+class MovePlanning:
+    """The caller's-thread part of ArmCore: checks and plans of the moves, and their queueing
+    (mixed in: it reads ArmCore's kinematics, frames, soft limits, motion settings and device)."""
+
+    planner: CartesianPlanner
+    _batch: threading.local               # the moves an `all_or_nothing` collects
+    _check_can_move: Callable[..., None]
+    _limit_rows: Callable[[], np.ndarray]
+
+    # === checks ======================================================================================
+    def _check_joint_target(self, goal_deg: np.ndarray, name: str) -> None:
+        lo, hi = self.soft_limit_joint[:, 0].tolist(), self.soft_limit_joint[:, 1].tolist()
+        for i, (q, a, b) in enumerate(zip(np.asarray(goal_deg, float).tolist(), lo, hi)):
+            if not a - 1e-9 <= q <= b + 1e-9:
+                raise value_error(f"{name}: J{i + 1} = {q:.10g}° is outside the soft limit "
+                                  f"[{a:g}, {b:g}]°")
+
+    def _check_joint_step(self, step_deg: np.ndarray, name: str) -> None:
+        """A relative move wider than a joint's soft-limit range leaves it from any start:
+        VALUE_ERR before the queue is looked at (a full queue would have hidden it)."""
+        span = (self.soft_limit_joint[:, 1] - self.soft_limit_joint[:, 0]).tolist()
+        for i, (d, w) in enumerate(zip(np.asarray(step_deg, float).tolist(), span)):
+            if abs(d) > w + 1e-9:
+                raise value_error(f"{name}: J{i + 1} by {d:g}° leaves the soft limit from any "
+                                  f"start (its range is {w:g}°)")
+
+    def _check_target(self, target: np.ndarray, label: str, frames: Frames | None = None) -> None:
+        """A target (4×4, m) within the Cartesian soft limit and the arm's reach, else VALUE_ERR.
+        Absolute targets are checked before the queue is looked at (a full queue would have
+        hidden it), and again when planned, with the frames in force then."""
+        self._check_cartesian_positions(target[None, :3, 3] * 1000.0, label)
+        self._check_reach(target[None, :3, 3], self.frames if frames is None else frames, label)
+
+    def _check_reach(self, positions: np.ndarray, frames: Frames, label: str) -> None:
+        """Control-point positions (robot frame, m) no farther from the shoulder than the arm,
+        hand and control-point offset reach, else VALUE_ERR: checked before any IK or planning,
+        so a target kilometres away is refused at once."""
+        kin = self.kin
+        to_robot = inverse(frames.base)
+        shoulder = to_robot[:3, :3] @ kin.shoulder + to_robot[:3, 3]
+        radius = kin.reach + kin.hand + float(np.linalg.norm(frames.tool[:3, 3]))
+        dist = np.linalg.norm(positions - shoulder, axis=1)
+        far = np.flatnonzero(~(dist <= radius + 1e-9))
+        if len(far):
+            k = int(far[0])
+            where = ("the target" if k == len(positions) - 1 else
+                     f"the path at {100.0 * k / max(1, len(positions) - 1):.0f} %")
+            raise value_error(f"{label}: {where} is out of reach: {dist[k] * 1e3:.6g} mm from the "
+                              f"shoulder, the arm reaches {radius * 1e3:.1f} mm")
+
+    def _check_cartesian_positions(self, positions_mm: np.ndarray, label: str) -> None:
+        lim = self.soft_limit_cartesian
+        hit = _first_exit(positions_mm, lim[:, 0], lim[:, 1], 1e-9)
+        if hit is not None:
+            k, axis = hit
+            where = "the target" if k == len(positions_mm) - 1 else "the path"
+            raise value_error(f"{label}: {where} leaves the Cartesian soft limit: "
+                              f"{'xyz'[axis]} = {positions_mm[k, axis]:.10g} mm, limit "
+                              f"[{lim[axis, 0]:g}, {lim[axis, 1]:g}] mm")
+
+    def _check_joint_path(self, qs_deg: np.ndarray, label: str) -> None:
+        lim = self.soft_limit_joint
+        hit = _first_exit(qs_deg, lim[:, 0], lim[:, 1], 1e-9)
+        if hit is not None:
+            k, j = hit
+            raise value_error(f"{label}: the path leaves the joint soft limit: J{j + 1} = "
+                              f"{qs_deg[k, j]:.10g}°, limit [{lim[j, 0]:g}, {lim[j, 1]:g}]°")
+
+    # === queueing ======================================================================================
+    def queue_joint_move(self, goal_of: Callable[[ArmSetpoint], np.ndarray], label: str,
+                          speed_ratio: float | None = None, ramp: float | None = None) -> dict:
+        """A PTP move to goal_of(start) (rad): synchronized trapezoid at the joint speed ratio
+        and accel time (or the given ones: STROLIC programs keep their own)."""
+        ratio = self.speed_joint if speed_ratio is None else speed_ratio
+        speed = np.radians(self.max_speed_joint) * ratio / 100.0
+        ramp = self.accel_time_joint if ramp is None else ramp
+
+        def plan(start: ArmSetpoint) -> ArmMotion:
+            frames = self.frames          # read while planning: the offsets wait for it
+            goal = goal_of(start)
+            self._check_joint_target(np.degrees(goal), label)
+            path = LinearJointPath(start.joints, goal)
+            steps = 1 + max(1, math.ceil(max(map(abs, np.degrees(path.delta).tolist()))))
+            ss = np.linspace(0.0, 1.0, steps)
+
+            def positions_mm(ss: np.ndarray) -> np.ndarray:
+                qs = path.q0 + ss[:, None] * path.delta
+                return frames.tool_of(self.kin.flange_many(qs))[:, :3, 3] * 1000.0
+            lim = self.soft_limit_cartesian
+            self._check_cartesian_positions(_near_limits_refined(
+                ss, positions_mm(ss), positions_mm, lim[:, 0], lim[:, 1], NEAR_LIMIT_MM), label)
+            timing = Trapezoid.for_axes(path.delta, speed, ramp)
+            return ArmMotion(path, timing, start.finger, start.finger, ramp, "joint")
+        return self._submit(plan, label)
+
+    def _elbow_goal(self, start_q: np.ndarray, flange: np.ndarray, psi: float | None,
+                    turn: float) -> tuple[float | None, float]:
+        """(psi, turn) for the planners. Abs: psi as given. Rel: psi = the start's arm angle +
+        turn, except where the start or the target is near the arm angle's undefined direction
+        (wrist left or right of the shoulder): there the elbow is carried along without twist
+        and turned by `turn` (psi None)."""
+        if psi is not None:
+            return psi, 0.0
+        kin = self.kin
+        u0 = kin.elbow_direction(start_q)[0]
+        w = kin.wrist_of(flange) - kin.shoulder
+        u1 = w / max(float(np.linalg.norm(w)), 1e-12)
+        if min(kin.reference_strength(u0), kin.reference_strength(u1)) > REL_ELBOW_CLEARANCE:
+            return kin.angle_of(*kin.elbow_direction(start_q)) + turn, 0.0
+        return None, turn
+
+    def _queue_ptp_cartesian(self, target_of: Callable[[np.ndarray], np.ndarray], label: str, *,
+                             psi: float | None = None, turn: float = 0.0) -> dict:
+        """A PTP move to the control-point pose target_of(start pose), with the elbow at arm
+        angle `psi`, or (Rel) turned by `turn` (rad) from where it starts."""
+        kin = self.kin
+        lo, hi = np.radians(self.soft_limit_joint[:, 0]), np.radians(self.soft_limit_joint[:, 1])
+
+        def goal_of(start: ArmSetpoint) -> np.ndarray:
+            frames = self.frames          # read while planning: the offsets wait for it
+            target = target_of(frames.tool_of(kin.flange(start.joints)))
+            self._check_target(target, label, frames)
+            flange = frames.flange_of(target)
+            goal_psi, goal_turn = self._elbow_goal(start.joints, flange, psi, turn)
+            try:
+                if goal_psi is not None:
+                    return kin.solve(flange, start.joints, psi=goal_psi, lower=lo, upper=hi)
+                u0, n0 = kin.elbow_direction(start.joints)
+                w = kin.wrist_of(flange) - kin.shoulder
+                u1 = w / max(float(np.linalg.norm(w)), 1e-12)
+                elbow = rotate_about(u1, goal_turn) @ kin.transport(n0, u0, u1)
+                return kin.solve(flange, start.joints, elbow_dir=elbow, lower=lo, upper=hi)
+            except Unreachable as e:
+                raise value_error(f"{label}: {e}") from None
+        return self.queue_joint_move(goal_of, label)
+
+    def queue_cartesian(self, path_of: Callable[[np.ndarray], LinePath], label: str, *,
+                         psi: float | None = None, turn: float = 0.0,
+                         speed_ratio: float | None = None, ramp: float | None = None) -> dict:
+        """A CP move along path_of(start pose); the elbow ends at arm angle `psi`, or (Rel) is
+        turned by `turn` (rad) from where it starts. Speed ratio and accel time: the port's
+        settings unless given."""
+        v, w = self.max_speed_cartesian
+        ratio = (self.speed_cartesian if speed_ratio is None else speed_ratio) / 100.0
+        ramp = self.accel_time_cartesian if ramp is None else ramp
+        limits = CartesianLimits(
+            speed=v * ratio / 1000.0, angular_speed=math.radians(w * ratio), ramp=ramp,
+            joint_velocity=np.radians(self.max_speed_joint),
+            joint_accel=np.radians(self.max_speed_joint) / self.min_accel_time_joint)
+
+        def plan(start: ArmSetpoint) -> ArmMotion:
+            frames = self.frames          # read while planning: the offsets wait for it
+            try:
+                path = path_of(frames.tool_of(self.kin.flange(start.joints)))
+                self.planner.check_length(path, frames)
+            except ValueError as e:
+                raise value_error(f"{label}: {e}") from None
+            coarse = positions_along(path, np.linspace(0.0, 1.0, REACH_SAMPLES + 1))
+            self._check_cartesian_positions(coarse * 1000.0, label)
+            self._check_reach(coarse, frames, label)
+            ss = np.linspace(0.0, 1.0, min(MAX_CHECK_SAMPLES,
+                                           1 + max(2, math.ceil(path.length / 0.002))))
+            self._check_cartesian_positions(positions_along(path, ss) * 1000.0, label)
+            goal_psi, goal_turn = self._elbow_goal(start.joints, frames.flange_of(path.pose(1.0)),
+                                                   psi, turn)
+            try:
+                result = self.planner.plan(path, frames, start.joints, limits, psi=goal_psi,
+                                           turn=goal_turn)
+            except Unreachable as e:
+                raise value_error(f"{label}: {e}") from None
+            dense = np.linspace(0.0, 1.0, 4 * len(result.path.ss))
+            lim = self.soft_limit_joint
+
+            def joints_deg(ss: np.ndarray) -> np.ndarray:
+                return np.degrees(result.path.spline(ss))
+            self._check_joint_path(_near_limits_refined(
+                dense, joints_deg(dense), joints_deg, lim[:, 0], lim[:, 1], NEAR_LIMIT_DEG), label)
+            return ArmMotion(result.path, result.timing, start.finger, start.finger, ramp,
+                             "cartesian")
+        return self._submit(plan, label)
+
+    def queue_gripper(self, ratio: int, label: str) -> dict:
+        self._check_can_move()
+        finger = self.finger_max * ratio / 100.0
+        speed = self.config.gripper_speed / 2000.0      # one finger, m/s
+        ramp = self.min_accel_time_joint
+
+        def plan(start: ArmSetpoint) -> ArmMotion:
+            timing = Trapezoid.for_axes(np.array([finger - start.finger]), np.array([speed]), ramp)
+            return ArmMotion(LinearJointPath(start.joints, start.joints), timing, start.finger,
+                             finger, ramp, "gripper")
+        return self._submit(plan, label)
+
+    def _submit(self, plan: Callable[[ArmSetpoint], ArmMotion], label: str) -> dict | Reply:
+        """Queue one planned move; inside `all_or_nothing` (on this thread), collect it."""
+        guarded = self._guarded(plan, label)
+        collected = getattr(self._batch, "plans", None)
+        if collected is not None:
+            collected.append((guarded, label))
+            return {"motion_id": 0}
+        motion_id = self.device.submit(guarded, label)
+        if motion_id is None:
+            raise self._full()
+        why = self.device.doomed(motion_id)
+        if why is not None:         # OK as 5.4.19 has it, and said: its wait will say the same
+            return Reply(R.OK, f"discarded: {why} (a stop discards every command given until "
+                               "the arm is at rest)", {"motion_id": motion_id})
+        return {"motion_id": motion_id}
+
+    @contextmanager
+    def all_or_nothing(self) -> Iterator[list[int]]:
+        """The moves queued inside the block (on this thread) go in together when it ends, each
+        planned from the end of the one before, or none of them: a refusal of any, or a queue
+        without room for all (FULL_MOTION_QUEUE_ERR), queues nothing. The list yielded gets
+        their ids, in order (a program's pose sequence is one command)."""
+        plans: list = []
+        self._batch.plans = plans
+        ids: list[int] = []
+        try:
+            yield ids
+        finally:
+            self._batch.plans = None
+        if plans:
+            got = self.device.submit_all(plans)
+            if got is None:
+                raise self._full()
+            ids.extend(got)
+
+    def _full(self) -> Refused:
+        return Refused(R.FULL_MOTION_QUEUE_ERR,
+                       f"the motion queue is full ({self.device.capacity} motions): wait or stop")
+
+    def _guarded(self, plan: Callable[[ArmSetpoint], ArmMotion],
+                 label: str) -> Callable[[ArmSetpoint], ArmMotion]:
+        def guarded(start: ArmSetpoint) -> ArmMotion:
+            """A refusal passes; any other failure of planning is this request's NG, said. The
+            servo and alarms are checked again here, after the device took its generation: a
+            servo_off (or an alarm) that came while this request waited for another's plan
+            stopped an idle arm, and the move would have been queued behind it."""
+            self._check_can_move()
+            limits = self._limit_rows()
+            try:
+                motion = plan(start)
+            except Refused:
+                raise
+            except Unreachable as e:
+                raise value_error(f"{label}: {e}") from None
+            except Exception as e:
+                raise Refused(R.NG, f"{label} could not be planned: {type(e).__name__}: {e}") \
+                    from None
+            if not math.isfinite(motion.duration):
+                raise value_error(f"{label}: the move would take forever at these settings")
+            motion.limits_checked = limits
+            return motion
+        return guarded
