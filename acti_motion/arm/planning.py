@@ -21,7 +21,7 @@ import numpy as np
 from acti_motion.arm.kinematics import Unreachable, rotate_about
 from acti_motion.arm.poses import Frames, inverse
 from acti_motion.arm.trajectories import (ArmMotion, ArmSetpoint, CartesianLimits,
-                                          CartesianPlanner, LinearJointPath, LinePath,
+                                          CartesianPath, CartesianPlanner, LinearJointPath,
                                           positions_along)
 from acti_motion.profiles import Trapezoid
 from acti_motion.replies import Refused, Reply, ReturnCode, value_error
@@ -205,7 +205,7 @@ class MovePlanning:
                 raise value_error(f"{label}: {e}") from None
         return self.queue_joint_move(goal_of, label)
 
-    def queue_cartesian(self, path_of: Callable[[np.ndarray], LinePath], label: str, *,
+    def queue_cartesian(self, path_of: Callable[[np.ndarray], CartesianPath], label: str, *,
                          psi: float | None = None, turn: float = 0.0,
                          speed_ratio: float | None = None, ramp: float | None = None) -> dict:
         """A CP move along path_of(start pose); the elbow ends at arm angle `psi`, or (Rel) is
