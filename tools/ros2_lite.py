@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import array
 import importlib
+import signal
 import sys
 import time
 from typing import Any, Callable
@@ -24,6 +25,7 @@ from rclpy.parameter import Parameter
 
 DISCOVERY_TIMEOUT_S = 30.0
 MATCH_WAIT_S = 2.0
+TEARDOWN_S = 5             # s the DDS teardown may take after the command is done
 SEQUENCES = (list, tuple, array.array, np.ndarray)
 
 
@@ -314,6 +316,12 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         pass
     finally:
+        sys.stdout.flush()
+        # Fast DDS can spin without end tearing a participant down (eprosima/Fast-DDS#6513;
+        # a `service call` burned a core for 5 min and ignored SIGTERM): the command is done,
+        # so the kernel ends the process if the teardown takes longer than TEARDOWN_S.
+        signal.signal(signal.SIGALRM, signal.SIG_DFL)
+        signal.alarm(TEARDOWN_S)
         node.destroy_node()
         rclpy.try_shutdown()
     return 0
