@@ -352,3 +352,17 @@ def test_offsets_are_refused_while_a_move_is_planned(arm, executor):  # noqa: F8
     run_until(executor, lambda: not arm.device.busy, 10.0)
     after = arm.get_feedback_pos_cartesian().values["pos"][0][3]
     assert after - before == pytest.approx(50.0, abs=0.05)
+
+
+def test_a_blend_is_watched_strictly_only_on_the_limits_that_changed_between_its_moves(arm):
+    """A blend of moves checked under different limits (one changed while paused) was watched
+    as if every limit had changed: a move back inside on any other row could be alarmed."""
+    a = arm.move_ptp_joint_rel([20.0] * 7).values["motion_id"]
+    b = arm.move_ptp_joint_rel([0.0, 20.0, 0.0, 0.0, 0.0, 0.0, 0.0]).values["motion_id"]
+    first, second = arm.device.queue[0].motion, arm.device.queue[1].motion
+    second.limits_checked = first.limits_checked.copy()
+    second.limits_checked[3, 1] -= 10.0                       # J4's upper limit changed
+    assert blend_with_previous(arm.device, b, a, 0.05, lambda q: arm.tool_pose(q)[:3, 3]) > 0.1
+    merged = arm.device.queue[1].motion.limits_checked
+    assert np.isnan(merged[3, 1]) and np.isnan(merged).sum() == 1
+    assert np.array_equal(np.delete(merged.ravel(), 7), np.delete(first.limits_checked.ravel(), 7))

@@ -84,8 +84,10 @@ class Blend:
         self.duration = nxt.duration
         self.ramp = max(prev.ramp, nxt.ramp)
         self.kind = nxt.kind
-        a, b = prev.limits_checked, nxt.limits_checked      # both the same, or none known
-        self.limits_checked = a if a is not None and b is not None and np.array_equal(a, b) else None
+        # the rows both were checked with; NaN where they differ (the watch is strict there),
+        # so that a limit set between the two plans does not make every other row strict too
+        a, b = prev.limits_checked, nxt.limits_checked
+        self.limits_checked = None if a is None or b is None else np.where(a == b, a, np.nan)
 
     def at(self, t: float) -> ArmSetpoint:
         b = self.next.at(t)
