@@ -49,6 +49,17 @@ class ExceptionKind(enum.Enum):
 DETAIL_CHARS = 1000     # of an exception's detail: it quotes the program (a 1 MB token)
 
 
+def _cut(detail: str) -> str:
+    """At most DETAIL_CHARS characters: the head and the tail (where the reason usually is)
+    around the length; cutting again changes nothing."""
+    if len(detail) <= DETAIL_CHARS:
+        return detail
+    note = f" … ({len(detail)} characters) … "
+    keep = DETAIL_CHARS - len(note)
+    head = keep * 2 // 3
+    return detail[:head] + note + detail[len(detail) - (keep - head):]
+
+
 class StrolicError(Exception):
     """An exception state: what happened, in which function, at which byte offset. The detail
     is cut to DETAIL_CHARS characters: it goes into results and log lines, and quotes what the
@@ -56,8 +67,7 @@ class StrolicError(Exception):
 
     def __init__(self, kind: ExceptionKind, detail: str = "", *,
                  function: str | None = None, offset: int | None = None) -> None:
-        if len(detail) > DETAIL_CHARS:
-            detail = f"{detail[:DETAIL_CHARS]}… ({len(detail)} characters)"
+        detail = _cut(detail)
         super().__init__(detail)
         self.kind = kind
         self.detail = detail

@@ -62,6 +62,7 @@ MAX_PROGRAM = 1 << 20      # bytes (code) or characters (text) of a program
 RESULT_ITEM = 65536        # characters of a stack item shown in the result …
 RESULT_ITEMS = 1000        # … the top-most stack items shown …
 RESULT_CHARS = 1 << 20     # … and the characters formatted for all of them
+CHARS_PER_BYTE = 6         # the most a datum's byte takes as text (\\xNN; "-128 " in an I1 array)
 
 
 def load(program: bytes | str) -> list:
@@ -87,15 +88,18 @@ def _bounded(entries: Iterable, size_of: Callable[[Any], int], text_of: Callable
     """Each entry's text while the texts keep within RESULT_ITEM characters each and about
     RESULT_CHARS in all, else its note. DUP shares a datum and a byte can take four characters
     (\\xNN): 13 copies of an 8 MB string made 436 MB of result text, 1000 of 64 KiB 262 MB,
-    and RESULT in a loop 120 MB of output. Formatting costs at least a character a byte, so the
-    budget bounds that work too."""
+    and RESULT in a loop 120 MB of output. An entry is formatted only when even its longest text
+    (CHARS_PER_BYTE a byte) would fit, so the work stays bounded too, and only the text kept is
+    charged; a number is always shown."""
     budget, shown = RESULT_CHARS, []
     for entry in entries:
         size = size_of(entry)
-        text = text_of(entry) if size <= min(RESULT_ITEM, budget) else ""
-        budget -= len(text)
-        if size and (not text or len(text) > RESULT_ITEM or budget < 0):
+        text = ""
+        if size == 0 or CHARS_PER_BYTE * size <= min(RESULT_ITEM, budget):
+            text = text_of(entry)            # a number always: a few characters
+        if size and (not text or len(text) > min(RESULT_ITEM, budget)):
             text = note_of(entry)
+        budget -= len(text)
         shown.append(text)
     return shown
 

@@ -327,7 +327,11 @@ def test_an_exception_quotes_at_most_a_thousand_characters_of_the_program() -> N
     """A 1 MB bad token was echoed whole into the run's result and its log line."""
     with pytest.raises(StrolicError) as caught:
         assemble("1 DROP " + "y" * 100000)
-    assert len(caught.value.report()) < 1100 and caught.value.report().endswith(" characters)")
+    report = caught.value.report()
+    assert len(report) < 1100 and "(100018 characters)" in report
+    with pytest.raises(StrolicError) as caught:          # the reason, at the end, is kept
+        assemble("I4:" + "9" * 3000)
+    assert "does not fit I4" in caught.value.report() and "(30" in caught.value.report()
 
 
 def _libc_snprintf(template: bytes, value: int) -> bytes:

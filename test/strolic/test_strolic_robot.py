@@ -14,7 +14,7 @@ from acti_motion.programs.run import (RESULT_CHARS, RESULT_ITEM, ProgramRun, Sta
                                       shown_stack)
 from acti_sim.world import World
 from sim_fixtures import executor  # noqa: F401
-from strolic.codes import Str
+from strolic.codes import I2, Num, Str
 from strolic.errors import ExceptionKind as K
 from strolic.literals import format_value
 from strolic.values import encode_value
@@ -214,6 +214,8 @@ def test_the_shown_stack_counts_characters_not_bytes():
     shown = shown_stack([small] * 1000)
     assert shown[-1] == format_value(small) and shown[0] == "Str<1000 bytes, not shown>"
     assert sum(map(len, shown)) < RESULT_CHARS + 40 * 1000
+    shown = shown_stack([Num(I2, 42), Str(b"hello"), *[big] * 20, Num(I2, 7)])
+    assert shown[:2] == ["I2:42", format_value(Str(b"hello"))] and shown[-1] == "I2:7"
     sent = [encode_value(small)] * 1000                     # RESULT in a loop: 120 MB of output
     shown = shown_output(sent)
     assert shown[0] == format_value(small) and shown[-1].endswith("bytes sent, not shown>")
