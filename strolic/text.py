@@ -211,6 +211,7 @@ class Assembler:
 
     def number(self, word: str, tag: int | None = None) -> Num:
         """A numeric literal; ``tag`` forces the type (typed literals and array elements)."""
+        element = tag is not None
         if ":" in word:
             name, word = word.split(":", 1)
             if TAGS_BY_NAME.get(name) not in NUMERIC_TAGS:
@@ -221,6 +222,9 @@ class Assembler:
             return smallest_int(value) if tag is None else make_number(tag, value)
         if REAL.match(word) and (tag is None or tag in REAL_TAGS):
             return make_number(tag or R8, float(word))
+        if element and not NUMBER_START.match(word):
+            raise self.error(f"{word!r} where a number of the array was expected (is its ] "
+                             "missing?)")
         raise self.error(f"{word!r} is not a number{' of that type' if tag else ''}")
 
     def reals(self, count: int) -> tuple[float, ...]:
@@ -260,6 +264,9 @@ class Assembler:
             return Pose(tuple(elements))
         if word == "Ar":
             return self.array()
+        if ":" not in word and not NUMBER_START.match(word):
+            raise self.error(f"{word!r} is no function, name or number (a misspelt function, "
+                             "or a name without .name?)")
         return self.number(word)
 
     def array(self) -> Array:
@@ -304,6 +311,7 @@ def resolve_labels(codes: list[Code], labels: dict[str, int],
 
 
 HEX_ESCAPE = re.compile(r"[0-9A-Fa-f]{1,2}")
+NUMBER_START = re.compile(r"[+-]?(\d|\.\d|inf|nan)", re.IGNORECASE)   # what a number can begin with
 
 def unescape(body: str, assembler: Assembler) -> bytes:
     out, i = bytearray(), 0

@@ -26,6 +26,7 @@ from rclpy.parameter import Parameter
 DISCOVERY_TIMEOUT_S = 30.0
 MATCH_WAIT_S = 2.0
 TEARDOWN_S = 5             # s the DDS teardown may take after the command is done
+LIST_WAIT_S = 4.0          # s a `list` waits at least for discovery
 SEQUENCES = (list, tuple, array.array, np.ndarray)
 
 
@@ -177,15 +178,19 @@ def topic_echo(node: Node, a: argparse.Namespace) -> None:
 
 
 def listing(node: Node, names_and_types: Callable[[], list], show_types: bool) -> None:
-    """What discovery finds, once it has found nothing new for MATCH_WAIT_S (a new participant
-    learns the others' endpoints over a few seconds)."""
-    found, settled_at = names_and_types(), time.monotonic()
-    deadline = settled_at + DISCOVERY_TIMEOUT_S
-    while time.monotonic() - settled_at < MATCH_WAIT_S and time.monotonic() < deadline:
+    """What discovery finds, once it has found no new node and no new name for MATCH_WAIT_S,
+    and not before LIST_WAIT_S: a new participant learns the others' nodes and endpoints over a
+    few seconds, longer on a busy machine (after 2 s, one list in five held only its own)."""
+    def seen() -> tuple[list, int]:
+        return names_and_types(), len(node.get_node_names_and_namespaces())
+    (found, nodes), start = seen(), time.monotonic()
+    settled_at = start
+    while (time.monotonic() - settled_at < MATCH_WAIT_S or time.monotonic() - start < LIST_WAIT_S) \
+            and time.monotonic() < start + DISCOVERY_TIMEOUT_S:
         rclpy.spin_once(node, timeout_sec=0.1)
-        now = names_and_types()
-        if len(now) != len(found):
-            found, settled_at = now, time.monotonic()
+        now, now_nodes = seen()
+        if (len(now), now_nodes) != (len(found), nodes):
+            (found, nodes), settled_at = (now, now_nodes), time.monotonic()
     for name, types in sorted(found):
         print(f"{name} [{', '.join(types)}]" if show_types else name)
 

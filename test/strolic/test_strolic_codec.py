@@ -328,7 +328,7 @@ def test_an_exception_quotes_at_most_a_thousand_characters_of_the_program() -> N
     with pytest.raises(StrolicError) as caught:
         assemble("1 DROP " + "y" * 100000)
     report = caught.value.report()
-    assert len(report) < 1100 and "(100018 characters)" in report
+    assert len(report) < 1100 and " characters) … " in report
     with pytest.raises(StrolicError) as caught:          # the reason, at the end, is kept
         assemble("I4:" + "9" * 3000)
     assert "does not fit I4" in caught.value.report() and "(30" in caught.value.report()
@@ -362,3 +362,16 @@ def test_encode2_integer_conversions_are_c89s(conversion: str) -> None:
                     if got != _libc_snprintf(template, value):
                         differ.append((template, value, got, _libc_snprintf(template, value)))
     assert differ == []
+
+
+@pytest.mark.parametrize("text, says", [
+    ("20 JSPEED DROP FOOBAR -1 $WAIT", "'FOOBAR' is no function, name or number"),
+    ("Ar[R8 1 2 3 ADRIVE", "is its ] missing?"),
+    ("I2:x", "'x' is not a number of that type"),
+])
+def test_a_word_that_is_no_code_says_what_it_is_not(text: str, says: str) -> None:
+    """A misspelt function read "'FOOBAR' is not a number"; an array without its ] "'ADRIVE' is
+    not a number of that type"."""
+    with pytest.raises(StrolicError) as caught:
+        assemble(text)
+    assert says in str(caught.value)
