@@ -295,10 +295,12 @@ class RobotHost(Host):
         arm = self.arm
         word = arm.state_word()
         opening = arm.get_feedback_pos_joint().values["pos"][7]
+        hand = self.hands.get(self.hand) or Hand()       # the openings of the hand in use
+        open_mm = self.max_opening if hand.open_mm is None else hand.open_mm
         flags = {"servo on": arm.servo, "moving": bool(word & STATE_MOVING),
                  "alarm": bool(word & STATE_ALARM), "paused": bool(word & STATE_PAUSED),
-                 "hand closed": opening < HAND_TOLERANCE_MM,
-                 "hand open": opening > self.max_opening - HAND_TOLERANCE_MM}
+                 "hand closed": opening < hand.close_mm + HAND_TOLERANCE_MM,
+                 "hand open": opening > open_mm - HAND_TOLERANCE_MM}
         return sum(1 << i for i, name in enumerate(STATUS_BITS) if flags[name])
 
     # === the program's motions ===================================================================

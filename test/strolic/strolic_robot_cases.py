@@ -164,6 +164,9 @@ CASES: dict[str, list[tuple]] = {
               ("Ar[R8 0 0 0 0 0 0 5] IDRIVE DROP HANDOPEN $DONE", ["I2:3"])],
     # ---- ED1E–ED23 hands --------------------------------------------------------------------------
     "HANDOPEN": [("HANDCLOSE HANDOPEN -1 $WAIT 16 DIN", [OK, "I2:33"]),
+                 # the open and closed bits follow the hand in use (bit 5 stayed off at 70 mm)
+                 ("Trn(0 0 0 1 0 0 0 1 0 0 0 1) 70 50 3 2 HANDDEF 2 HANDCHG HANDOPEN -1 $WAIT "
+                  "16 DIN HANDCLOSE -1 $WAIT 16 DIN", [OK, OK, OK, "I2:33", OK, "I2:17"]),
                  ("HANDOPEN", K.SERVO_ERROR, {"servo": False})],
     "HANDCLOSE": [("HANDCLOSE -1 $WAIT 16 DIN", [OK, "I2:17"]),
                   ("Trn(0 0 0 1 0 0 0 1 0 0 0 1) 70 50 3 2 HANDDEF 2 HANDCHG HANDCLOSE -1 $WAIT",
