@@ -12,7 +12,7 @@ from rclpy.node import Node
 from acti_bringup.serving.adapter import Plane, serve_operations
 from acti_bringup.serving.parameters import Setting, declare_config, sync_parameters
 from acti_bringup.serving.spinning import steady_timer, warn_of_namesakes
-from acti_bringup.simulation import Simulation
+from acti_bringup.simulation import Simulation, stamp
 from acti_middle_node.actions import ActionConfig, MotionActions
 from acti_middle_node.operations import OPERATIONS
 from acti_middle_node.program_action import ProgramAction
@@ -72,12 +72,12 @@ class ArmNode(Node):
     def _publish_state(self) -> None:
         sync_parameters(self)             # settings changed through the services, as parameters
         core = self.core
-        q = core.feedback_joints
+        t, q = core.measured()
         pose = core.tool_pose(q)
         quat = pin.Quaternion(pose[:3, :3]).coeffs()          # x, y, z, w
         motion_id, label, progress, queued = core.motion_status()
         msg = ArmState(
-            stamp=self.simulation.now(), state=core.state_word(), queue_length=queued,
+            stamp=stamp(t), state=core.state_word(), queue_length=queued,
             alarms=[Alarm(code=a.code, type=int(a.type), description=a.description)
                     for a in core.alarms],
             position=[float(x) for x in pose[:3, 3]], orientation=[float(x) for x in quat],

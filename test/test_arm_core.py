@@ -105,3 +105,15 @@ def test_servo_off_while_moving_stops_first(arm, executor):  # noqa: F811
     took = run_until(executor, lambda: not arm.device.busy, 2.0)
     assert took <= arm.accel_time_joint + 0.01
     assert arm.state_word() == 0
+
+
+def test_the_measurement_and_its_time_are_read_together(arm, executor):  # noqa: F811
+    """~/state read the joints, then the clock: a step between the two stamped the pose one
+    period late (1.2 mm at 300 mm/s against TF at that stamp)."""
+    ready(arm)
+    assert arm.move_ptp_joint_rel([10.0] * 7).ok
+    for _ in range(30):
+        executor.step()
+        t, q = arm.measured()
+        assert t == executor.world.time and q is arm.feedback_joints
+        assert np.allclose(q, executor.world.arm_positions())

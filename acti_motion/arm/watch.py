@@ -53,6 +53,7 @@ class SoftLimitWatch:
     def _sample(self, world: World) -> None:
         """After every step (`MotionExecutor.after_step`): the feedback, then the watch."""
         self._feedback = world.arm_positions()
+        self._measured = (world.time, self._feedback)     # one assignment: read together
         self._finger = world.gripper_position()
         self._watch()
 
