@@ -9,7 +9,8 @@ import pytest
 from acti_msgs import srv
 from acti_msgs.msg import CartesianSpeed, LimitValue
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
-from rcl_interfaces.srv import DescribeParameters, GetParameters, ListParameters, SetParameters
+from rcl_interfaces.srv import (DescribeParameters, GetParameters, ListParameters, SetParameters,
+                                SetParametersAtomically)
 
 from acti_bringup.serving.parameters import field_descriptions
 from ros_harness import node_fixture, wait_until
@@ -119,6 +120,23 @@ def test_a_bad_value_is_refused_with_the_services_reason(ros, arm_node, name, ki
     assert not r.successful and words in r.reason, r.reason
     assert get_param(ros, name) == before
     assert arm_node.alive()
+
+
+def test_an_atomic_set_with_a_refused_value_changes_nothing(ros, arm_node):
+    """The values before the refused one stayed applied: max_speed_translation became 124 and
+    min_accel_time_joint 0.3 though the set answered unsuccessful."""
+    names = ["max_speed_translation", "min_accel_time_joint", "accel_time_joint"]
+    before = [get_param(ros, n) for n in names]
+    speed0 = ros.call(srv.GetMaxSpeedCartesian, ARM + "get_max_speed_cartesian").speed
+    r = ros.call(SetParametersAtomically, ARM + "set_parameters_atomically", parameters=[
+        Parameter(name="max_speed_translation", value=value(ParameterType.PARAMETER_DOUBLE, 124.0)),
+        Parameter(name="min_accel_time_joint", value=value(ParameterType.PARAMETER_DOUBLE, 0.2)),
+        Parameter(name="accel_time_joint", value=value(ParameterType.PARAMETER_DOUBLE, 0.1))])
+    assert not r.result.successful and "minimum" in r.result.reason, r.result.reason
+    speed = ros.call(srv.GetMaxSpeedCartesian, ARM + "get_max_speed_cartesian").speed
+    minimum = ros.call(srv.GetMinAccelTimeJoint, ARM + "get_min_accel_time_joint").acl_time
+    assert speed.translation == speed0.translation and minimum == before[1].double_value
+    assert [get_param(ros, n) for n in names] == before
 
 
 @pytest.mark.parametrize("name, kind, x", [

@@ -388,7 +388,11 @@ def test_pause_reports_busy_until_the_base_is_at_rest(base, executor, trace):  #
 
 @pytest.mark.parametrize("config, words", [
     (dict(default_velocity_translation=2000.0), "default velocity"),
-    (dict(default_accel_rotation=0.0), "default acceleration"),
+    (dict(default_accel_rotation=0.0), "default_accel_rotation is 0.0"),
+    (dict(default_accel_rotation=0.5), "default acceleration"),     # within its range, below the minimum
+    # a negative minimum let set_velocity take -5 mm/s (the base went Stuck)
+    (dict(velocity_min_translation=-5.0), "velocity_min_translation is -5.0"),
+    (dict(jog_timeout=0), "jog_timeout is 0"),
     (dict(jog_timeout=0), "jog_timeout"),
     # was accepted: a target anywhere in 1e300 mm, a stop that would take hours, a NaN charge
     (dict(work_area=1e300), "work_area is 1e+300: it must be within 1 … 1e+06"),

@@ -88,6 +88,10 @@ class _Parameters:
                 if self.node.has_parameter(p.name) else p for p in parameters]
 
     def _apply(self, parameters: list[Parameter]) -> SetParametersResult:
+        """Apply each value through its setting; if one is refused, put back what the others
+        changed (an atomic set changes nothing or everything: a refused one left the values
+        before the bad one applied)."""
+        before = {name: _as_parameter_value(s.read()) for name, s in self.settings.items()}
         for p in parameters:
             setting = self.settings.get(p.name)
             if setting is None or not self.node.has_parameter(p.name):
@@ -97,8 +101,18 @@ class _Parameters:
             value = tuple(p.value) if isinstance(p.value, (list, tuple)) else p.value
             reply = setting.apply(value)
             if not reply.ok:
+                self._restore(before)
                 return SetParametersResult(successful=False, reason=reply.comment)
         return SetParametersResult(successful=True)
+
+    def _restore(self, before: dict[str, Any]) -> None:
+        """Every setting back to its value in `before`; a second pass for settings that bound
+        each other (a minimum and the value above it), which only one order accepts."""
+        for _ in range(2):
+            for name, value in reversed(before.items()):
+                setting = self.settings[name]
+                if _as_parameter_value(setting.read()) != value:
+                    setting.apply(tuple(value) if isinstance(value, list) else value)
 
     def sync(self) -> None:
         """Set every settable parameter whose value differs from the one in force."""

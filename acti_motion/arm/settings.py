@@ -56,7 +56,7 @@ class ArmConfig:
     # maximum CP rotation and elbow speed [degree/s] (set_max_speed_cartesian)
     max_speed_rotation: float = ranged(90.0, *SPEED_ROTATION_DEG_S)
     # gripper opening speed, both fingers [mm/s]
-    gripper_speed: float = 100.0
+    gripper_speed: float = ranged(100.0, 1.0, 1000.0)
     # Cartesian soft limits of the control point, robot frame [mm]: x lower, x upper, y lower,
     # y upper, z lower, z upper (set_soft_limit_cartesian)
     soft_limit_cartesian: tuple[float, ...] = (-1000.0, 1200.0, -1000.0, 1000.0, -100.0, 1600.0)
@@ -70,8 +70,6 @@ def _check_config(c: ArmConfig) -> None:
     """The start-up settings that have no setter, else ValueError (the node does not start);
     the others are applied through their setters (`ArmCore._apply_settings`)."""
     check_ranges(c, "arm configuration")
-    if not (math.isfinite(c.gripper_speed) and c.gripper_speed > 0):
-        raise ValueError(f"gripper_speed must be finite and > 0, got {c.gripper_speed}")
 
 
 def _in_range(x: float, lo: float, hi: float, name: str, unit: str) -> float:

@@ -24,19 +24,27 @@ class VehicleConfig:
     accel_limit_translation: float = ranged(1000.0, 1.0, 100000.0)
     # acceleration limit, rotation [degree/s²]
     accel_limit_rotation: float = ranged(180.0, 0.1, 36000.0)
-    velocity_min_translation: float = 1.0        # mm/s: the slowest velocity setting (set_velocity)
-    velocity_min_rotation: float = 0.1           # degree/s: the slowest yaw-rate setting
-    accel_min_translation: float = 1.0           # mm/s²: the lowest acceleration setting
-    accel_min_rotation: float = 1.0              # degree/s²: the lowest angular acceleration setting
-    default_velocity_translation: float = 300.0  # velocity at start-up [mm/s]
-    default_velocity_rotation: float = 45.0      # turn rate at start-up [degree/s]
-    default_accel_translation: float = 500.0     # acceleration at start-up [mm/s²]
-    default_accel_rotation: float = 90.0         # turn acceleration at start-up [degree/s²]
+    # mm/s: the slowest velocity setting (set_velocity)
+    velocity_min_translation: float = ranged(1.0, 0.1, 10000.0)
+    # degree/s: the slowest yaw-rate setting
+    velocity_min_rotation: float = ranged(0.1, 0.01, 3600.0)
+    # mm/s²: the lowest acceleration setting
+    accel_min_translation: float = ranged(1.0, 0.1, 100000.0)
+    # degree/s²: the lowest angular acceleration setting
+    accel_min_rotation: float = ranged(1.0, 0.01, 36000.0)
+    # velocity at start-up [mm/s]
+    default_velocity_translation: float = ranged(300.0, 0.1, 10000.0)
+    # turn rate at start-up [degree/s]
+    default_velocity_rotation: float = ranged(45.0, 0.01, 3600.0)
+    # acceleration at start-up [mm/s²]
+    default_accel_translation: float = ranged(500.0, 0.1, 100000.0)
+    # turn acceleration at start-up [degree/s²]
+    default_accel_rotation: float = ranged(90.0, 0.01, 36000.0)
     # mm: targets and set_position within ±this in x and y
     work_area: float = ranged(100000.0, 1.0, 1000000.0)
     # degree: the largest rotation a move or set_position asks
     turn_limit: float = ranged(3600.0, 1.0, 36000.0)
-    jog_timeout: int = 500                       # ms from the last jog command to the stop
+    jog_timeout: int = ranged(500, 1, 32767)     # ms from the last jog command to the stop
     joy_axis_linear: int = ranged(1, 0, 63)      # sensor_msgs/Joy axis for forward speed …
     joy_axis_angular: int = ranged(0, 0, 63)     # … and for the yaw rate (left stick)
     joy_enable_button: int = ranged(-1, -1, 127)  # a button that must be held (-1: none)
@@ -55,8 +63,9 @@ class VehicleConfig:
 
 
 def check_config(c: VehicleConfig) -> None:
-    """ValueError unless every ranged field is within its range, the battery's cut-off is below
-    its warning level, and a stop from the velocity limit at the acceleration limit takes at most
+    """ValueError unless every ranged field is within its range (the start-up velocity and
+    acceleration are checked against the minimums and limits as the setters would, by
+    VehicleCore), the battery's cut-off is below its warning level, and a stop from the velocity limit at the acceleration limit takes at most
     MAX_STOP_S, in translation and in rotation."""
     check_ranges(c, "vehicle configuration")
     if not c.battery_cutoff_voltage < c.battery_low_voltage:

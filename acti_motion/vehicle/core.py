@@ -82,8 +82,6 @@ class VehicleCore(Control, Planning, Sensing):
                 "default acceleration", ("mm/s²", "degree/s²"))
         except Refused as r:
             raise ValueError(f"vehicle configuration: {r.comment}") from None
-        if c.jog_timeout <= 0:
-            raise ValueError(f"vehicle configuration: jog_timeout is {c.jog_timeout} ms, it must be > 0")
         self.jog_timeout = c.jog_timeout
         self.joystick = False
         self._dt = executor.dt
