@@ -5,7 +5,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Callable
 
-import pinocchio as pin
 from acti_msgs.msg import Alarm, ArmState, ReturnId
 from rclpy.node import Node
 
@@ -17,6 +16,7 @@ from acti_middle_node.actions import ActionConfig, MotionActions
 from acti_middle_node.operations import OPERATIONS
 from acti_middle_node.program_action import ProgramAction
 from acti_motion.arm.core import ArmConfig, ArmCore
+from acti_motion.arm.poses import quaternion_xyzw
 from acti_motion.replies import Reply
 from acti_motion.programs.robot import ProgramDefaults
 from acti_motion.config_fields import RATE_RANGE_HZ, ranged
@@ -74,7 +74,7 @@ class ArmNode(Node):
         core = self.core
         t, q = core.measured()
         pose = core.tool_pose(q)
-        quat = pin.Quaternion(pose[:3, :3]).coeffs()          # x, y, z, w
+        quat = quaternion_xyzw(pose[:3, :3])
         motion_id, label, progress, queued = core.motion_status()
         msg = ArmState(
             stamp=stamp(t), state=core.state_word(), queue_length=queued,

@@ -20,7 +20,6 @@ from dataclasses import dataclass
 from typing import Any, Callable
 
 import numpy as np
-import pinocchio as pin
 from rclpy.node import Node
 from sensor_msgs.msg import CameraInfo, Image
 from tf2_msgs.msg import TFMessage
@@ -28,6 +27,7 @@ from tf2_msgs.msg import TFMessage
 from acti_bringup.serving.parameters import declare_config
 from acti_bringup.visual.transforms import link_transform, static_tf_publisher
 from acti_motion.executor import MotionExecutor
+from acti_motion.arm.poses import quaternion_xyzw
 from acti_motion.link_poses import LinkTransform
 from acti_sim.world import World
 
@@ -70,7 +70,7 @@ def optical_frame(eye: tuple[float, ...], target: tuple[float, ...]) -> LinkTran
     x = np.cross(z, [0.0, 0.0, 1.0])
     x /= np.linalg.norm(x)
     rotation = np.column_stack([x, np.cross(z, x), z])
-    q = pin.Quaternion(rotation).coeffs()
+    q = quaternion_xyzw(rotation)
     return LinkTransform(PARENT_FRAME, OPTICAL_FRAME, tuple(float(v) for v in eye),
                          tuple(float(v) for v in q))
 
