@@ -123,3 +123,11 @@ def test_a_stop_ends_the_wait_on_the_current_motion_only_once_it_is_at_rest(wait
     threading.Timer(0.05, lambda: [d.tick(None, 0.1) for _ in range(10)]).start()
     out = wait(d, Goal(1, timeout=5.0), period=10.0)
     assert out.end == "succeed" and not out.completed and d.current is None
+
+
+def test_a_timeout_is_answered_at_its_deadline_not_at_the_next_tick(wait):
+    """The deadline was checked on the feedback tick only: a 0.01 s timeout was answered after
+    0.106 s. Here the tick is 30 s away: the deadline itself must end the wait."""
+    d = device_with(1)
+    out = wait(d, Goal(1, timeout=0.05), period=30.0)
+    assert out.end == "abort" and "timed out after 0.05 s" in out.message
