@@ -483,7 +483,13 @@ class _Listener:
 
 class MotionExecutor:
     """Steps the world (at its own fixed time step) on a thread of its own, `real_time_factor`
-    times faster than wall time (0: as fast as it can), and advances every device each step."""
+    times faster than wall time (0: as fast as it can), and advances every device each step.
+
+    A loop that falls more than BEHIND_REPORT_S behind its schedule (held up, not merely slow by
+    a step) says so in the log, once per fall, as a real-time controller reports an overrun;
+    it then steps back to back until it has caught up."""
+
+    BEHIND_REPORT_S = 0.05
 
     def __init__(self, world: World, real_time_factor: float = 1.0,
                  alive: Callable[[], bool] = lambda: True) -> None:
@@ -499,6 +505,8 @@ class MotionExecutor:
         self._thread: threading.Thread | None = None
         self._running = threading.Event()
         self.steps = 0
+        self.falls_behind = 0           # how often the loop fell BEHIND_REPORT_S behind
+        self._behind = False
 
     def add_device(self, name: str, capacity: int, hold: Any) -> Device:
         """A motion queue whose device rests at set-point `hold` until its first motion."""
@@ -568,5 +576,16 @@ class MotionExecutor:
             ahead = 0.0
             if self.real_time_factor > 0:
                 ahead = (self.world.time - sim0) / self.real_time_factor - (time.monotonic() - wall0)
+                self._note_lateness(-ahead)
             # Sleeping (even 0 s) hands the GIL to service threads once per step.
             time.sleep(max(ahead, 0.0))
+
+    def _note_lateness(self, behind: float) -> None:
+        """Report a fall behind the schedule once, when it begins; ready again once caught up."""
+        if behind > self.BEHIND_REPORT_S and not self._behind:
+            self._behind = True
+            self.falls_behind += 1
+            _log.warning(f"the control loop fell {behind * 1e3:.0f} ms behind real time (held "
+                         "up: it steps back to back to catch up)")
+        elif behind <= self.dt:
+            self._behind = False

@@ -4,8 +4,10 @@ from __future__ import annotations
 import signal
 
 import pytest
+from rclpy.experimental import EventsExecutor
 
 from acti_bringup.harness import Actions, NodeProcess, RosClient, wait_until  # noqa: F401
+from acti_bringup.serving.spinning import SpinLoop
 
 TEST_RATE = "real_time_factor:=4.0"
 
@@ -38,3 +40,19 @@ def node_fixture(module: str, *params: str, namespace: str = "", params_yaml: st
         assert "Traceback" not in node.log(), f"{module} logged an exception:\n{node.log()}"
     return fixture
 
+
+@pytest.fixture
+def events_loop(ros):
+    """A node on an EventsExecutor driven by a SpinLoop; the process's signal handlers are put
+    back afterwards (the EventsExecutor installs its own)."""
+    saved = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    node = ros.rclpy.create_node("spin_loop_test")
+    executor = EventsExecutor()
+    executor.add_node(node)
+    loop = SpinLoop(executor, "test-events")
+    yield node, loop
+    loop.stop()
+    executor.shutdown()
+    node.destroy_node()
+    for s, handler in saved.items():
+        signal.signal(s, handler)

@@ -10,28 +10,10 @@ import time
 
 import pytest
 from acti_msgs.srv import GetState, VehicleGetState
-from rclpy.experimental import EventsExecutor
 from std_srvs.srv import Trigger
 
-from acti_bringup.serving.spinning import SPIN_TIMEOUT_S, Planes, SpinLoop
+from acti_bringup.serving.spinning import SPIN_TIMEOUT_S, Planes
 from ros_harness import NodeProcess, wait_until
-
-
-@pytest.fixture
-def events_loop(ros):
-    """A node on an EventsExecutor driven by a SpinLoop; the process's signal handlers are put
-    back afterwards (the EventsExecutor installs its own)."""
-    saved = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
-    node = ros.rclpy.create_node("spin_loop_test")
-    executor = EventsExecutor()
-    executor.add_node(node)
-    loop = SpinLoop(executor, "test-events")
-    yield node, loop
-    loop.stop()
-    executor.shutdown()
-    node.destroy_node()
-    for s, handler in saved.items():
-        signal.signal(s, handler)
 
 
 def test_a_spin_loop_serves_services_and_timers_and_stops_at_once(ros, events_loop):
@@ -76,7 +58,7 @@ def test_the_planes_resend_what_dds_could_not_deliver_on_every_service_they_serv
         planes.add("control", [node])
         senders = {s.service_name: s.send_response.__qualname__ for s in node.services}
         assert "/planes_test/ping" in senders and "/planes_test/list_parameters" in senders
-        assert all(q.startswith("LateResponses._sender") for q in senders.values()), senders
+        assert all(q.startswith("LateResponses._responder") for q in senders.values()), senders
         planes.start()
         assert ros.call(Trigger, "/planes_test/ping").success
     finally:

@@ -5,16 +5,22 @@ discovered the client's response reader. Fast DDS then waits 100 ms for that rea
 rclpy turns the failure into a RuntimeWarning and the response is lost: the client waits forever
 (ros2/ros2#1253). A late client is therefore answered again, a few times over a few seconds, by a
 thread of its own, and the log says so once per service when it never could be. A response
-that cannot be sent at all is one log line: raised, it would end the executor's serving."""
+that cannot be sent at all is one log line: raised, it would end the executor's serving.
+
+Every response leaves through the process's outbox (`acti_bringup.serving.outbox`), converted
+at once and sent without the GIL: a send that DDS holds back never holds the serving thread."""
 from __future__ import annotations
 
 import heapq
 import threading
 import time
 import warnings
-from typing import Any, Callable, Iterable
+from typing import Any, Callable, Iterable, NamedTuple
 
 from rclpy.node import Node
+
+from acti_bringup.serving.outbox import Outbox
+from acti_bringup.serving.unlocked import CMessage, MessageKind, rcl, request_id
 
 UNDELIVERED = "failed to send response"     # the start of rclpy's warning on a timeout
 RETRY_AFTER_S = (0.05, 0.2, 0.5, 1.0, 2.0, 4.0)   # each retry may block up to 100 ms in rmw
@@ -48,11 +54,55 @@ def delivered(send: Callable[[Any, Any], None], response: Any, header: Any) -> b
     return not _failed.flag
 
 
-class LateResponses:
-    """Sends again, on its own thread, the responses that DDS could not deliver at once."""
+class Prepared(NamedTuple):
+    """One response ready to go: send() says whether DDS delivered it; discard() if never sent."""
+    send: Callable[[], bool]
+    discard: Callable[[], None] = lambda: None
 
-    def __init__(self, log: Callable[[str], None]) -> None:
+
+class RclpySender:
+    """Prepares responses for rclpy's own send (under the GIL)."""
+
+    def __init__(self, service: Any) -> None:
+        self._send = service.send_response
+
+    def prepare(self, response: Any, header: Any) -> Prepared:
+        return Prepared(lambda: delivered(self._send, response, header))
+
+
+class UnlockedSender:
+    """Prepares responses for rcl's send without the GIL (`unlocked`): converted now; rclpy's
+    send where the header cannot be read or rcl is not found."""
+
+    def __init__(self, service: Any) -> None:
+        self._fallback = RclpySender(service)
+        self._handle = service.handle
+        self._kind = MessageKind(service.srv_type.Response)
+
+    def prepare(self, response: Any, header: Any) -> Prepared:
+        lib = rcl()
+        copied = request_id(header) if lib is not None else None
+        if copied is None:
+            return self._fallback.prepare(response, header)
+        message = CMessage(self._kind, response)
+
+        def send() -> bool:
+            return message.send(self._handle, lambda s, m: lib.send_response(s, copied, m))
+        return Prepared(send, message.discard)
+
+
+Sender = Callable[[Any], "RclpySender | UnlockedSender"]
+
+
+class LateResponses:
+    """Sends every response through the outbox, and again, on its own thread, the responses
+    that DDS could not deliver at once."""
+
+    def __init__(self, log: Callable[[str], None], outbox: Outbox,
+                 sender_of: Sender = UnlockedSender) -> None:
         self._log = log
+        self._outbox = outbox
+        self._sender_of = sender_of
         self._due: list[tuple[float, int, int, Callable, Any, Any, str]] = []
         self._count = 0
         self._wake = threading.Condition()
@@ -65,22 +115,35 @@ class LateResponses:
         _install_warning_hook()
         for node in nodes:
             for service in node.services:
-                service.send_response = self._sender(service.send_response, service.service_name)
+                service.send_response = self._responder(self._sender_of(service),
+                                                        service.service_name)
 
-    def _sender(self, send: Callable[[Any, Any], None], name: str) -> Callable[[Any, Any], None]:
+    def _responder(self, sender: RclpySender | UnlockedSender,
+                   name: str) -> Callable[[Any, Any], None]:
+        """service.send_response: prepare the response here, send it on the outbox thread."""
         def send_response(response: Any, header: Any) -> None:
             try:
-                if not delivered(send, response, header):
-                    self._later(0, send, response, header, name)
+                prepared = sender.prepare(response, header)
             except Exception as e:   # raised out of the executor, it would end the serving
                 self._log(f"a response to {name} could not be sent: {type(e).__name__}: {e}")
+                return
+            self._outbox.put(lambda: self._deliver(prepared, sender, response, header, name),
+                             prepared.discard)
         return send_response
 
-    def _later(self, attempt: int, send: Callable, response: Any, header: Any, name: str) -> None:
+    def _deliver(self, prepared: Prepared, sender: Any, response: Any, header: Any,
+                 name: str) -> None:
+        try:
+            if not prepared.send():
+                self._later(0, sender, response, header, name)
+        except Exception as e:
+            self._log(f"a response to {name} could not be sent: {type(e).__name__}: {e}")
+
+    def _later(self, attempt: int, sender: Any, response: Any, header: Any, name: str) -> None:
         with self._wake:
             self._count += 1
             due = time.monotonic() + RETRY_AFTER_S[attempt]
-            heapq.heappush(self._due, (due, self._count, attempt, send, response, header, name))
+            heapq.heappush(self._due, (due, self._count, attempt, sender, response, header, name))
             self._wake.notify()
 
     def _run(self) -> None:
@@ -88,15 +151,15 @@ class LateResponses:
             with self._wake:
                 while not self._due or self._due[0][0] > time.monotonic():
                     self._wake.wait(None if not self._due else self._due[0][0] - time.monotonic())
-                _, _, attempt, send, response, header, name = heapq.heappop(self._due)
+                _, _, attempt, sender, response, header, name = heapq.heappop(self._due)
             try:
-                if delivered(send, response, header):
+                if sender.prepare(response, header).send():
                     continue
             except Exception as e:   # the service was destroyed, the process ends
                 self._log(f"response to {name} not sent again: {e}")
                 continue
             if attempt + 1 < len(RETRY_AFTER_S):
-                self._later(attempt + 1, send, response, header, name)
+                self._later(attempt + 1, sender, response, header, name)
             elif name not in self._given_up:
                 self._given_up.add(name)
                 self._log(f"a response to {name} was never delivered: its client was not "

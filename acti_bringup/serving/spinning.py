@@ -9,6 +9,10 @@
 - The goal plane (the action servers) runs on a `SingleThreadedExecutor`: goals are coroutines
   that await (`acti_bringup.serving.waiting`), which the EventsExecutor would poll without pause.
 
+What the planes and the control loop send (responses, messages, action feedback) leaves through
+one outbox thread, without the GIL (`acti_bringup.serving.outbox`): a send that DDS holds back
+holds no plane and no control step.
+
 Each executor is driven by a `spin_once` loop (the EventsExecutor's `spin()` serves nothing in
 this rclpy and neither honours SIGINT); SIGINT and SIGTERM are handled here, on the main thread.
 """
@@ -21,6 +25,7 @@ import threading
 from typing import Callable, Iterable, NoReturn, TypeVar
 
 import rclpy
+from rclpy.action import ActionServer
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.executors import Executor, SingleThreadedExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation
@@ -32,6 +37,7 @@ from rclpy.node import Node
 from rclpy.publisher import Publisher
 from rclpy.timer import Timer
 
+from acti_bringup.serving.outbox import Outbox, unlock_feedback, unlocked_publish
 from acti_bringup.serving.responses import LateResponses
 
 RCLError = rclpy_implementation.RCLError
@@ -180,13 +186,20 @@ class Planes:
     def __init__(self) -> None:
         self.executors = {plane: kind() for plane, kind in self.KINDS.items()}
         self._loops: list[SpinLoop] = []
-        self._late = LateResponses(get_logger("acti_responses").warning)
+        self.outbox = Outbox(get_logger("acti_outbox").warning)
+        self._late = LateResponses(get_logger("acti_responses").warning, self.outbox)
 
     def add(self, plane: str, nodes: Iterable[Node]) -> None:
-        """Serve the nodes on the plane; a response DDS cannot deliver yet is sent again."""
+        """Serve the nodes on the plane. What they send leaves through the outbox; a response
+        DDS cannot deliver yet is sent again."""
         nodes = list(nodes)
         for n in nodes:
             self.executors[plane].add_node(n)
+            for publisher in n.publishers:
+                publisher.publish = unlocked_publish(self.outbox, publisher)
+            for waitable in n.waitables:
+                if isinstance(waitable, ActionServer):
+                    unlock_feedback(waitable, self.outbox)
         self._late.serve(nodes)
 
     def start(self) -> None:
@@ -203,6 +216,7 @@ class Planes:
             loop.stop()
         for ex in self.executors.values():
             ex.shutdown(timeout_sec=5.0)
+        self.outbox.stop()
 
 
 def wait_for_signal(still_serving: Callable[[], bool]) -> None:
