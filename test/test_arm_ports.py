@@ -283,6 +283,19 @@ def test_alarm_refuses_every_motion_until_cleared(arm, op):
     assert getattr(arm, op)(**{**MOVES, **GRIPPER}[op]).ok
 
 
+def test_move_gripper_answers_its_state_error_before_its_argument(arm):
+    """5.4.9 lists NOT_SV_ON_ERR, STATUS_ERR and VALUE_ERR; the arm answers a motion command's
+    state error first (README: servo off, an alarm), as every move and the other gripper
+    commands do: moveGripper(101) with the servo off or an alarm active was VALUE_ERR."""
+    r = arm.move_gripper(101)
+    assert r.code == R.NOT_SV_ON_ERR and "servo_on" in r.comment, r
+    ready(arm)
+    arm._alarms.append(arm_alarm())
+    r = arm.move_gripper(101)
+    assert r.code == R.STATUS_ERR and "clear_alarms" in r.comment, r
+    assert arm.clear_alarms().ok and arm.move_gripper(101).code == R.VALUE_ERR
+
+
 def arm_alarm():
     from acti_motion.arm.core import Alarm, AlarmType
     return Alarm(0x5, AlarmType.WARNING, "test")

@@ -494,7 +494,9 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     @returns(R.STATUS_ERR, R.VALUE_ERR, R.NOT_SV_ON_ERR)
     @plans
     def move_gripper(self, angle_ratio: int) -> dict:
-        """The spec lists no FULL_MOTION_QUEUE_ERR here: a full queue is STATUS_ERR."""
+        """The spec lists no FULL_MOTION_QUEUE_ERR here: a full queue is STATUS_ERR. The state
+        is answered before the argument, as by every motion command."""
+        self._check_can_move()
         ratio = ratio_percent(angle_ratio, "angle_ratio")
         try:
             return self.queue_gripper(ratio, "move_gripper")
