@@ -262,3 +262,21 @@ def test_a_bad_absolute_target_is_value_err_on_a_full_queue_too(arm, call):
     assert arm.device.full
     r = call(arm)
     assert r.code == R.VALUE_ERR and r.comment, r
+
+
+def test_a_relative_step_back_into_moved_soft_limits_is_accepted(arm, executor):  # noqa: F811
+    """5.4.15 refuses (VALUE_ERR) only a bad value: with J1's soft limit set to 50 … 60° while it
+    rests at 0°, +55° ends inside it, as movePTPJointAbs to 55° does. The check made before the
+    queue called a step wider than the limit's span (10°) one that "leaves it from any start";
+    a step no start within the hardware range can take is still refused there (full queue)."""
+    limits = [tuple(x) for x in arm.get_soft_limit_joint().values["soft_limit"]]
+    limits[0] = (60.0, 50.0)
+    assert arm.set_soft_limit_joint(limits).ok
+    r = arm.move_ptp_joint_rel([55.0] + [0.0] * 6)
+    assert r.ok, r.comment
+    run_until(executor, lambda: not arm.device.busy, 30.0)
+    assert arm.get_feedback_pos_joint().values["pos"][0] == pytest.approx(55.0, abs=0.05)
+    while arm.move_ptp_joint_rel([0.0] * 6 + [0.1]).ok:
+        pass
+    r = arm.move_ptp_joint_rel([-250.0] + [0.0] * 6)         # from +170 at most: -80 < 50
+    assert r.code == R.VALUE_ERR and "from any start" in r.comment, r

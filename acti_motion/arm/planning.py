@@ -87,13 +87,16 @@ class MovePlanning:
                                   f"[{a:g}, {b:g}]°")
 
     def _check_joint_step(self, step_deg: np.ndarray, name: str) -> None:
-        """A relative move wider than a joint's soft-limit range leaves it from any start:
-        VALUE_ERR before the queue is looked at (a full queue would have hidden it)."""
-        span = (self.soft_limit_joint[:, 1] - self.soft_limit_joint[:, 0]).tolist()
-        for i, (d, w) in enumerate(zip(np.asarray(step_deg, float).tolist(), span)):
-            if abs(d) > w + 1e-9:
-                raise value_error(f"{name}: J{i + 1} by {d:g}° leaves the soft limit from any "
-                                  f"start (its range is {w:g}°)")
+        """A relative step that takes no start within the hardware range into the soft limits
+        is VALUE_ERR before the queue is looked at (a full queue would have hidden it). Only
+        that: the arm may rest outside soft limits set since, and a step back in is a move."""
+        soft, hard = self.soft_limit_joint, self.hard_limit_joint
+        lowest, highest = (soft[:, 0] - hard[:, 1]).tolist(), (soft[:, 1] - hard[:, 0]).tolist()
+        for i, (d, lo, hi) in enumerate(zip(np.asarray(step_deg, float).tolist(), lowest, highest)):
+            if not lo - 1e-9 <= d <= hi + 1e-9:
+                raise value_error(f"{name}: J{i + 1} by {d:g}° leaves the soft limit "
+                                  f"[{soft[i, 0]:g}, {soft[i, 1]:g}]° from any start within its "
+                                  f"range [{hard[i, 0]:g}, {hard[i, 1]:g}]°")
 
     def _check_target(self, target: np.ndarray, label: str, frames: Frames | None = None) -> None:
         """A target (4×4, m) within the Cartesian soft limit and the arm's reach, else VALUE_ERR.
