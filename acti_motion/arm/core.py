@@ -162,8 +162,10 @@ class ArmCore(SoftLimitWatch, MovePlanning):
 
     @returns(*GETTER)
     def get_manip_info(self) -> Reply:
+        """cmd_cycle is the control period in whole ms (ULONG), at least 1: a period under
+        1 ms (rate_hz up to 2000) is not a command cycle of none."""
         period_ms = self.executor.dt * 1000.0
-        cycle_ms = round(period_ms)
+        cycle_ms = max(1, round(period_ms))
         info = ("acti_ros2", "7-axis SRS arm with 1-axis gripper (PyBullet)", self.axis_count,
                 cycle_ms, True)
         comment = ("" if abs(period_ms - cycle_ms) < 1e-9 else
