@@ -280,3 +280,19 @@ def test_a_relative_step_back_into_moved_soft_limits_is_accepted(arm, executor):
         pass
     r = arm.move_ptp_joint_rel([-250.0] + [0.0] * 6)         # from +170 at most: -80 < 50
     assert r.code == R.VALUE_ERR and "from any start" in r.comment, r
+
+
+@pytest.mark.parametrize("call", [
+    lambda a: a.move_ptp_cartesian_rel((hg(dx=5000.0), 0.0, 0)),
+    lambda a: a.move_linear_cartesian_rel((hg(dz=-5000.0), 0.0, 0)),
+    lambda a: a.move_circular_cartesian_rel((hg(dy=5000.0), 0.0, 0), (hg(dx=100.0), 0.0, 0)),
+    lambda a: a.move_circular_cartesian_rel((hg(dy=100.0), 0.0, 0), (hg(dx=5000.0), 0.0, 0))])
+def test_a_cartesian_step_longer_than_the_reach_is_value_err_on_a_full_queue_too(arm, call):
+    """5.4.11/5.4.13 (VALUE_ERR: a bad value): a relative step longer than the diameter of the
+    ball the control point reaches ends out of reach from any start, as a joint step no start
+    can take; on a full queue it was FULL_MOTION_QUEUE_ERR."""
+    while arm.move_ptp_joint_rel([0.0] * 6 + [0.1]).ok:
+        pass
+    assert arm.device.full
+    r = call(arm)
+    assert r.code == R.VALUE_ERR and "reach" in r.comment, r

@@ -439,6 +439,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     def move_ptp_cartesian_rel(self, car_point: tuple) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
         delta, turn = _car_point(car_point, "car_point")
+        self._check_step(delta, "move_ptp_cartesian_rel")
         return self._queue_ptp_cartesian(lambda P0: compose_relative(P0, delta),
                                          "move_ptp_cartesian_rel", turn=turn)
 
@@ -456,6 +457,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     def move_linear_cartesian_rel(self, car_point: tuple) -> dict:
         self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
         delta, turn = _car_point(car_point, "car_point")
+        self._check_step(delta, "move_linear_cartesian_rel")
         return self.queue_cartesian(lambda P0: LinePath(P0, compose_relative(P0, delta)),
                                      "move_linear_cartesian_rel", turn=turn)
 
@@ -478,6 +480,8 @@ class ArmCore(SoftLimitWatch, MovePlanning):
         self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
         via, _ = _car_point(car_point_r, "car_point_r")
         delta, turn = _car_point(car_point_t, "car_point_t")
+        self._check_step(via, "move_circular_cartesian_rel: car_point_r")
+        self._check_step(delta, "move_circular_cartesian_rel")
         return self.queue_cartesian(
             lambda P0: ArcPath(P0, P0[:3, 3] + via[:3, 3], compose_relative(P0, delta)),
             "move_circular_cartesian_rel", turn=turn)

@@ -112,7 +112,7 @@ class MovePlanning:
         kin = self.kin
         to_robot = inverse(frames.base)
         shoulder = to_robot[:3, :3] @ kin.shoulder + to_robot[:3, 3]
-        radius = kin.reach + kin.hand + float(np.linalg.norm(frames.tool[:3, 3]))
+        radius = self.planner.reach_radius(frames)
         dist = np.linalg.norm(positions - shoulder, axis=1)
         far = np.flatnonzero(~(dist <= radius + 1e-9))
         if len(far):
@@ -121,6 +121,15 @@ class MovePlanning:
                      f"the path at {100.0 * k / max(1, len(positions) - 1):.0f} %")
             raise value_error(f"{label}: {where} is out of reach: {dist[k] * 1e3:.6g} mm from the "
                               f"shoulder, the arm reaches {radius * 1e3:.1f} mm")
+
+    def _check_step(self, delta: np.ndarray, label: str) -> None:
+        """A relative step (4×4, m) longer than the reach's ball is wide ends out of reach from
+        any start: VALUE_ERR before the queue is looked at (a full queue would have hidden it)."""
+        diameter = 2.0 * self.planner.reach_radius(self.frames)
+        step = float(np.linalg.norm(delta[:3, 3]))
+        if step > diameter + 1e-9:
+            raise value_error(f"{label}: a step of {step * 1e3:.6g} mm is out of reach from any "
+                              f"start: the arm reaches {diameter * 1e3:.1f} mm across")
 
     def _check_cartesian_positions(self, positions_mm: np.ndarray, label: str) -> None:
         lim = self.soft_limit_cartesian
