@@ -296,3 +296,18 @@ def test_a_cartesian_step_longer_than_the_reach_is_value_err_on_a_full_queue_too
     assert arm.device.full
     r = call(arm)
     assert r.code == R.VALUE_ERR and "reach" in r.comment, r
+
+
+def test_go_home_outside_the_soft_limits_is_value_err_on_a_full_queue_too(arm):
+    """goHome (2014) is a move to an absolute target: a home that soft limits set since leave
+    out is VALUE_ERR before the queue is looked at, as movePTPJointAbs's (it was
+    FULL_MOTION_QUEUE_ERR on a full queue)."""
+    limits = [tuple(x) for x in arm.get_soft_limit_joint().values["soft_limit"]]
+    limits[0] = (60.0, -60.0)
+    assert arm.set_home([90.0] + list(WORK[1:])).ok
+    assert arm.set_soft_limit_joint(limits).ok
+    while arm.move_ptp_joint_rel([0.0] * 6 + [0.1]).ok:
+        pass
+    assert arm.device.full
+    r = arm.go_home()
+    assert r.code == R.VALUE_ERR and "J1 = 90° is outside the soft limit" in r.comment, r

@@ -406,9 +406,8 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     @plans
     def move_ptp_joint_abs(self, joint_points: list[float]) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
-        goal = np.radians(finite_vector(joint_points, self.axis_count, "joint_points"))
-        self._check_joint_target(np.degrees(goal), "move_ptp_joint_abs")   # before the queue
-        return self.queue_joint_move(lambda start: goal, "move_ptp_joint_abs")
+        goal = finite_vector(joint_points, self.axis_count, "joint_points")
+        return self._queue_joint_target(goal, "move_ptp_joint_abs")
 
     @returns(*MOVE)
     @plans
@@ -423,8 +422,14 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     @plans
     def go_home(self) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
-        goal = np.radians(self.home)
-        return self.queue_joint_move(lambda start: goal, "go_home")
+        return self._queue_joint_target(self.home, "go_home")
+
+    def _queue_joint_target(self, goal_deg: np.ndarray, label: str) -> dict:
+        """A PTP move to an absolute target (degree), checked against the soft limits before
+        the queue is looked at: a full queue would have hidden that it is wrong from any start."""
+        self._check_joint_target(goal_deg, label)
+        goal = np.radians(goal_deg)
+        return self.queue_joint_move(lambda start: goal, label)
 
     @returns(*MOVE)
     @plans
