@@ -169,7 +169,6 @@ def test_soft_limit_cartesian(arm):
 @pytest.mark.parametrize("limits, words", [
     ([(90.0, -90.0)] * 6, "7 limits"), ([(90.0, -90.0)] * 8, "7 limits"),
     ([(-90.0, 90.0)] + [(90.0, -90.0)] * 6, "above lower"),
-    ([(10.0, 10.0)] + [(90.0, -90.0)] * 6, "above lower"),
     ([(NAN, -90.0)] + [(90.0, -90.0)] * 6, "finite"),
     ([(90.0, -90.0)] * 6 + [(180.0, -90.0)], "hardware"),
 ])
@@ -177,6 +176,18 @@ def test_soft_limit_joint_refusals(arm, limits, words):
     r = arm.set_soft_limit_joint(limits)
     assert r.code == R.VALUE_ERR and words in r.comment
     assert arm.get_soft_limit_joint().values["soft_limit"][0][0] == pytest.approx(170.0, abs=1e-3)
+
+
+def test_a_joint_soft_limit_may_pin_a_joint(arm):
+    """setSoftLimitJoint (common port) is VALUE_ERR for upper < lower, not for upper = lower:
+    a joint held at one value (J7 at 0°) was refused with "upper must be above lower"."""
+    ready(arm)
+    limits = [(90.0, -90.0)] * 6 + [(0.0, 0.0)]
+    assert arm.set_soft_limit_joint(limits).ok
+    assert arm.get_soft_limit_joint().values["soft_limit"][6] == (0.0, 0.0)
+    assert arm.move_ptp_joint_rel([5.0] + [0.0] * 6).ok
+    r = arm.move_ptp_joint_rel([0.0] * 6 + [0.5])
+    assert r.code == R.VALUE_ERR and "J7" in r.comment, r.comment
 
 
 def test_soft_limit_joint_round_trip_and_check(arm):

@@ -197,7 +197,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
                               f" got {len(soft_limit)}")
         limits = np.empty((self.axis_count, 2))
         for i, lim in enumerate(soft_limit):
-            upper, lower = _limit_value(lim, f"soft_limit[{i}] (J{i + 1})")
+            upper, lower = _limit_value(lim, f"soft_limit[{i}] (J{i + 1})", pinned=True)
             hlo, hhi = self.hard_limit_joint[i]
             if lower < hlo - 1e-9 or upper > hhi + 1e-9:
                 raise value_error(f"soft_limit[{i}]: [{lower:g}, {upper:g}]° is outside J{i + 1}'s "
