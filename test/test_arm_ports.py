@@ -223,6 +223,21 @@ def test_base_offset_moves_the_robot_frame(arm):
     assert (before[3], before[7]) == pytest.approx((163.0, 0.0), abs=1e-3)
 
 
+def test_get_base_offset_answers_the_offset_as_it_was_set(arm):
+    """5.4.2/5.4.22: getBaseOffset gets the offset setBaseOffset set. A translation of
+    -1023.3 mm came back as -1023.2999999999998 (mm → m → mm), and an exact rotation
+    (cos 45° = 0.7071067811865476) as 0.7071067811865475; a rounded rotation comes back as the
+    rotation in force."""
+    c = math.sqrt(0.5)
+    offset = [c, -c, 0.0, -1023.3, c, c, 0.0, 0.7, 0.0, 0.0, 1.0, 1500.9]
+    assert arm.set_base_offset(offset).ok
+    assert arm.get_base_offset().values["offset"] == offset
+    rounded = [0.7071, -0.7071, 0.0, 10.0, 0.7071, 0.7071, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+    assert arm.set_base_offset(rounded).ok
+    got = arm.get_base_offset().values["offset"]
+    assert got[0] == pytest.approx(c, abs=1e-12) and got[3::4] == [10.0, 0.0, 0.0]
+
+
 def test_control_point_offset_moves_the_control_point(arm):
     tool = moved(IDENTITY, dz=100.0)
     assert arm.set_control_point_offset(tool).ok

@@ -27,7 +27,7 @@ import numpy as np
 
 from acti_motion.arm.kinematics import ArmKinematics
 from acti_motion.arm.planning import MovePlanning
-from acti_motion.arm.poses import Frames, compose_relative, pose_to_hg
+from acti_motion.arm.poses import Frames, compose_relative, hg_as_set, pose_to_hg
 from acti_motion.arm.settings import (BASE_OFFSET_MM, CONTROL_POINT_OFFSET_MM, MAX_ACCEL_TIME_S,
                                       MIN_SPEED_JOINT_DEG_S, RATED_ROUNDING_DEG_S,
                                       SOFT_LIMIT_CARTESIAN_MM, SPEED_ROTATION_DEG_S,
@@ -224,7 +224,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
 
     @returns(*GETTER)
     def get_base_offset(self) -> dict:
-        return {"offset": pose_to_hg(self.frames.base)}
+        return {"offset": list(self.frames.base_hg)}
 
     @returns(*GETTER)
     def get_max_speed_cartesian(self) -> dict:
@@ -340,7 +340,8 @@ class ArmCore(SoftLimitWatch, MovePlanning):
         100 mm from where the new frame said it should."""
         base = _offset(offset, BASE_OFFSET_MM, ReturnCode.VALUE_ERR)
         self._set_while_idle("set_base_offset", R.NG, "its target is in the present robot frame",
-                             lambda: setattr(self, "frames", Frames(base, self.frames.tool)))
+                             lambda: setattr(self, "frames",
+                                             self.frames.with_base(base, hg_as_set(base, offset))))
 
     @returns(R.STATUS_ERR)
     def set_control_point_offset(self, offset: list[float]) -> None:
@@ -350,7 +351,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
         tool = _offset(offset, CONTROL_POINT_OFFSET_MM, ReturnCode.NG)
         self._set_while_idle("set_control_point_offset", R.STATUS_ERR,
                              "it was planned for the present control point",
-                             lambda: setattr(self, "frames", Frames(self.frames.base, tool)))
+                             lambda: setattr(self, "frames", self.frames.with_tool(tool)))
 
     def _set_while_idle(self, name: str, code: ReturnCode, why: str,
                         apply: Callable[[], None]) -> None:
