@@ -311,3 +311,18 @@ def test_go_home_outside_the_soft_limits_is_value_err_on_a_full_queue_too(arm):
     assert arm.device.full
     r = arm.go_home()
     assert r.code == R.VALUE_ERR and "J1 = 90° is outside the soft limit" in r.comment, r
+
+
+@pytest.mark.parametrize("op", ["move_ptp_cartesian_abs", "move_linear_cartesian_abs"])
+def test_an_absolute_pose_no_joints_reach_is_value_err_on_a_full_queue_too(arm, op):
+    """5.4.10/5.4.12 (VALUE_ERR: a bad value): whether a joint solution within the soft limits
+    reaches an absolute pose with its elbow does not depend on the start (all eight branches are
+    tried); the flange turned half a turn about z here has none (J7's ±175°). On a full queue
+    it was FULL_MOTION_QUEUE_ERR."""
+    here = arm.get_feedback_pos_cartesian().values["pos"][0]
+    turned = [-1.0, 0.0, 0.0, here[3], 0.0, -1.0, 0.0, here[7], 0.0, 0.0, 1.0, here[11]]
+    while arm.move_ptp_joint_rel([0.0] * 6 + [0.1]).ok:
+        pass
+    assert arm.device.full
+    r = getattr(arm, op)((turned, 0.0, 0))
+    assert r.code == R.VALUE_ERR and "no joint solution" in r.comment, r

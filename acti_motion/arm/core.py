@@ -437,7 +437,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     def move_ptp_cartesian_abs(self, car_point: tuple) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
         target, psi = _car_point(car_point, "car_point")
-        self._check_target(target, "move_ptp_cartesian_abs")
+        self._check_target(target, "move_ptp_cartesian_abs", psi=psi)
         return self._queue_ptp_cartesian(lambda P0: target, "move_ptp_cartesian_abs", psi=psi)
 
     @returns(*MOVE)
@@ -454,7 +454,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     def move_linear_cartesian_abs(self, car_point: tuple) -> dict:
         self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
         target, psi = _car_point(car_point, "car_point")
-        self._check_target(target, "move_linear_cartesian_abs")
+        self._check_target(target, "move_linear_cartesian_abs", psi=psi)
         return self.queue_cartesian(lambda P0: LinePath(P0, target), "move_linear_cartesian_abs",
                                      psi=psi)
 
@@ -476,7 +476,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
         via, _ = _car_point(car_point_r, "car_point_r")
         target, psi = _car_point(car_point_t, "car_point_t")
         self._check_target(via, "move_circular_cartesian_abs: car_point_r")
-        self._check_target(target, "move_circular_cartesian_abs")
+        self._check_target(target, "move_circular_cartesian_abs", psi=psi)
         return self.queue_cartesian(lambda P0: ArcPath(P0, via[:3, 3], target),
                                      "move_circular_cartesian_abs", psi=psi)
 

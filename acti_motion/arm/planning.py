@@ -98,12 +98,23 @@ class MovePlanning:
                                   f"[{soft[i, 0]:g}, {soft[i, 1]:g}]° from any start within its "
                                   f"range [{hard[i, 0]:g}, {hard[i, 1]:g}]°")
 
-    def _check_target(self, target: np.ndarray, label: str, frames: Frames | None = None) -> None:
-        """A target (4×4, m) within the Cartesian soft limit and the arm's reach, else VALUE_ERR.
-        Absolute targets are checked before the queue is looked at (a full queue would have
-        hidden it), and again when planned, with the frames in force then."""
+    def _check_target(self, target: np.ndarray, label: str, frames: Frames | None = None,
+                      psi: float | None = None) -> None:
+        """A target (4×4, m) within the Cartesian soft limit and the arm's reach and, given its
+        elbow `psi` (rad), one a joint solution within the joint soft limits reaches, else
+        VALUE_ERR. None of this depends on the start (IK tries all eight branches): absolute
+        targets are checked before the queue is looked at (a full queue would have hidden it),
+        and again when planned, with the frames in force then."""
+        frames = self.frames if frames is None else frames
         self._check_cartesian_positions(target[None, :3, 3] * 1000.0, label)
-        self._check_reach(target[None, :3, 3], self.frames if frames is None else frames, label)
+        self._check_reach(target[None, :3, 3], frames, label)
+        if psi is not None:
+            lim = np.radians(self.soft_limit_joint)
+            try:
+                self.kin.solve(frames.flange_of(target), self.device.queued_end.joints, psi=psi,
+                               lower=lim[:, 0], upper=lim[:, 1])
+            except Unreachable as e:
+                raise value_error(f"{label}: {e}") from None
 
     def _check_reach(self, positions: np.ndarray, frames: Frames, label: str) -> None:
         """Control-point positions (robot frame, m) no farther from the shoulder than the arm,
