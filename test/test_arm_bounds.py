@@ -262,3 +262,67 @@ def test_a_bad_absolute_target_is_value_err_on_a_full_queue_too(arm, call):
     assert arm.device.full
     r = call(arm)
     assert r.code == R.VALUE_ERR and r.comment, r
+
+
+def test_a_relative_step_back_into_moved_soft_limits_is_accepted(arm, executor):  # noqa: F811
+    """5.4.15 refuses (VALUE_ERR) only a bad value: with J1's soft limit set to 50 … 60° while it
+    rests at 0°, +55° ends inside it, as movePTPJointAbs to 55° does. The check made before the
+    queue called a step wider than the limit's span (10°) one that "leaves it from any start";
+    a step no start within the hardware range can take is still refused there (full queue)."""
+    limits = [tuple(x) for x in arm.get_soft_limit_joint().values["soft_limit"]]
+    limits[0] = (60.0, 50.0)
+    assert arm.set_soft_limit_joint(limits).ok
+    r = arm.move_ptp_joint_rel([55.0] + [0.0] * 6)
+    assert r.ok, r.comment
+    run_until(executor, lambda: not arm.device.busy, 30.0)
+    assert arm.get_feedback_pos_joint().values["pos"][0] == pytest.approx(55.0, abs=0.05)
+    while arm.move_ptp_joint_rel([0.0] * 6 + [0.1]).ok:
+        pass
+    r = arm.move_ptp_joint_rel([-250.0] + [0.0] * 6)         # from +170 at most: -80 < 50
+    assert r.code == R.VALUE_ERR and "from any start" in r.comment, r
+
+
+@pytest.mark.parametrize("call", [
+    lambda a: a.move_ptp_cartesian_rel((hg(dx=5000.0), 0.0, 0)),
+    lambda a: a.move_linear_cartesian_rel((hg(dz=-5000.0), 0.0, 0)),
+    lambda a: a.move_circular_cartesian_rel((hg(dy=5000.0), 0.0, 0), (hg(dx=100.0), 0.0, 0)),
+    lambda a: a.move_circular_cartesian_rel((hg(dy=100.0), 0.0, 0), (hg(dx=5000.0), 0.0, 0))])
+def test_a_cartesian_step_longer_than_the_reach_is_value_err_on_a_full_queue_too(arm, call):
+    """5.4.11/5.4.13 (VALUE_ERR: a bad value): a relative step longer than the diameter of the
+    ball the control point reaches ends out of reach from any start, as a joint step no start
+    can take; on a full queue it was FULL_MOTION_QUEUE_ERR."""
+    while arm.move_ptp_joint_rel([0.0] * 6 + [0.1]).ok:
+        pass
+    assert arm.device.full
+    r = call(arm)
+    assert r.code == R.VALUE_ERR and "reach" in r.comment, r
+
+
+def test_go_home_outside_the_soft_limits_is_value_err_on_a_full_queue_too(arm):
+    """goHome (2014) is a move to an absolute target: a home that soft limits set since leave
+    out is VALUE_ERR before the queue is looked at, as movePTPJointAbs's (it was
+    FULL_MOTION_QUEUE_ERR on a full queue)."""
+    limits = [tuple(x) for x in arm.get_soft_limit_joint().values["soft_limit"]]
+    limits[0] = (60.0, -60.0)
+    assert arm.set_home([90.0] + list(WORK[1:])).ok
+    assert arm.set_soft_limit_joint(limits).ok
+    while arm.move_ptp_joint_rel([0.0] * 6 + [0.1]).ok:
+        pass
+    assert arm.device.full
+    r = arm.go_home()
+    assert r.code == R.VALUE_ERR and "J1 = 90° is outside the soft limit" in r.comment, r
+
+
+@pytest.mark.parametrize("op", ["move_ptp_cartesian_abs", "move_linear_cartesian_abs"])
+def test_an_absolute_pose_no_joints_reach_is_value_err_on_a_full_queue_too(arm, op):
+    """5.4.10/5.4.12 (VALUE_ERR: a bad value): whether a joint solution within the soft limits
+    reaches an absolute pose with its elbow does not depend on the start (all eight branches are
+    tried); the flange turned half a turn about z here has none (J7's ±175°). On a full queue
+    it was FULL_MOTION_QUEUE_ERR."""
+    here = arm.get_feedback_pos_cartesian().values["pos"][0]
+    turned = [-1.0, 0.0, 0.0, here[3], 0.0, -1.0, 0.0, here[7], 0.0, 0.0, 1.0, here[11]]
+    while arm.move_ptp_joint_rel([0.0] * 6 + [0.1]).ok:
+        pass
+    assert arm.device.full
+    r = getattr(arm, op)((turned, 0.0, 0))
+    assert r.code == R.VALUE_ERR and "no joint solution" in r.comment, r

@@ -169,7 +169,6 @@ def test_soft_limit_cartesian(arm):
 @pytest.mark.parametrize("limits, words", [
     ([(90.0, -90.0)] * 6, "7 limits"), ([(90.0, -90.0)] * 8, "7 limits"),
     ([(-90.0, 90.0)] + [(90.0, -90.0)] * 6, "above lower"),
-    ([(10.0, 10.0)] + [(90.0, -90.0)] * 6, "above lower"),
     ([(NAN, -90.0)] + [(90.0, -90.0)] * 6, "finite"),
     ([(90.0, -90.0)] * 6 + [(180.0, -90.0)], "hardware"),
 ])
@@ -177,6 +176,18 @@ def test_soft_limit_joint_refusals(arm, limits, words):
     r = arm.set_soft_limit_joint(limits)
     assert r.code == R.VALUE_ERR and words in r.comment
     assert arm.get_soft_limit_joint().values["soft_limit"][0][0] == pytest.approx(170.0, abs=1e-3)
+
+
+def test_a_joint_soft_limit_may_pin_a_joint(arm):
+    """setSoftLimitJoint (common port) is VALUE_ERR for upper < lower, not for upper = lower:
+    a joint held at one value (J7 at 0°) was refused with "upper must be above lower"."""
+    ready(arm)
+    limits = [(90.0, -90.0)] * 6 + [(0.0, 0.0)]
+    assert arm.set_soft_limit_joint(limits).ok
+    assert arm.get_soft_limit_joint().values["soft_limit"][6] == (0.0, 0.0)
+    assert arm.move_ptp_joint_rel([5.0] + [0.0] * 6).ok
+    r = arm.move_ptp_joint_rel([0.0] * 6 + [0.5])
+    assert r.code == R.VALUE_ERR and "J7" in r.comment, r.comment
 
 
 def test_soft_limit_joint_round_trip_and_check(arm):
@@ -210,6 +221,21 @@ def test_base_offset_moves_the_robot_frame(arm):
     # arm-frame (163, 0) is robot-frame R⁻¹(p − t) = (0, -63)
     assert (hg[3], hg[7], hg[11]) == pytest.approx((0.0, -63.0, 1341.9395), abs=1e-3)
     assert (before[3], before[7]) == pytest.approx((163.0, 0.0), abs=1e-3)
+
+
+def test_get_base_offset_answers_the_offset_as_it_was_set(arm):
+    """5.4.2/5.4.22: getBaseOffset gets the offset setBaseOffset set. A translation of
+    -1023.3 mm came back as -1023.2999999999998 (mm → m → mm), and an exact rotation
+    (cos 45° = 0.7071067811865476) as 0.7071067811865475; a rounded rotation comes back as the
+    rotation in force."""
+    c = math.sqrt(0.5)
+    offset = [c, -c, 0.0, -1023.3, c, c, 0.0, 0.7, 0.0, 0.0, 1.0, 1500.9]
+    assert arm.set_base_offset(offset).ok
+    assert arm.get_base_offset().values["offset"] == offset
+    rounded = [0.7071, -0.7071, 0.0, 10.0, 0.7071, 0.7071, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+    assert arm.set_base_offset(rounded).ok
+    got = arm.get_base_offset().values["offset"]
+    assert got[0] == pytest.approx(c, abs=1e-12) and got[3::4] == [10.0, 0.0, 0.0]
 
 
 def test_control_point_offset_moves_the_control_point(arm):
@@ -281,6 +307,19 @@ def test_alarm_refuses_every_motion_until_cleared(arm, op):
     assert arm.get_active_alarm().values["alarms"] == [(0x5, 1, "test")]
     assert arm.clear_alarms().ok and arm.get_state().values["state"] == 0x01
     assert getattr(arm, op)(**{**MOVES, **GRIPPER}[op]).ok
+
+
+def test_move_gripper_answers_its_state_error_before_its_argument(arm):
+    """5.4.9 lists NOT_SV_ON_ERR, STATUS_ERR and VALUE_ERR; the arm answers a motion command's
+    state error first (README: servo off, an alarm), as every move and the other gripper
+    commands do: moveGripper(101) with the servo off or an alarm active was VALUE_ERR."""
+    r = arm.move_gripper(101)
+    assert r.code == R.NOT_SV_ON_ERR and "servo_on" in r.comment, r
+    ready(arm)
+    arm._alarms.append(arm_alarm())
+    r = arm.move_gripper(101)
+    assert r.code == R.STATUS_ERR and "clear_alarms" in r.comment, r
+    assert arm.clear_alarms().ok and arm.move_gripper(101).code == R.VALUE_ERR
 
 
 def arm_alarm():

@@ -247,13 +247,16 @@ def test_control_point_offset_is_refused_while_paused_mid_move(arm, executor, tr
     trace.check()
 
 
-@pytest.mark.parametrize("rate_hz, comment", [(250.0, ""), (240.0, "4.1667 ms")])
-def test_cmd_cycle_is_the_control_period(rate_hz, comment):
+@pytest.mark.parametrize("rate_hz, comment, cycle_ms", [(250.0, "", 4), (240.0, "4.1667 ms", 4),
+                                                      (2000.0, "0.5000 ms", 1)])
+def test_cmd_cycle_is_the_control_period(rate_hz, comment, cycle_ms):
+    """ManipInfo.cmdCycle (common port) is the period of the position command in whole ms: at
+    2 kHz (rate_hz's top) 0.5 ms was rounded to 0, a command cycle of none; it is 1, said."""
     world = World(time_step=1.0 / rate_hz)
     try:
         arm = ArmCore(MotionExecutor(world, 0.0))
         r = arm.get_manip_info()
-        assert r.values["manip_info"][3] == 4
+        assert r.values["manip_info"][3] == cycle_ms
         assert (comment in r.comment) and (bool(r.comment) == bool(comment))
     finally:
         world.close()

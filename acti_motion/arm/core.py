@@ -27,7 +27,7 @@ import numpy as np
 
 from acti_motion.arm.kinematics import ArmKinematics
 from acti_motion.arm.planning import MovePlanning
-from acti_motion.arm.poses import Frames, compose_relative, pose_to_hg
+from acti_motion.arm.poses import Frames, compose_relative, hg_as_set, pose_to_hg
 from acti_motion.arm.settings import (BASE_OFFSET_MM, CONTROL_POINT_OFFSET_MM, MAX_ACCEL_TIME_S,
                                       MIN_SPEED_JOINT_DEG_S, RATED_ROUNDING_DEG_S,
                                       SOFT_LIMIT_CARTESIAN_MM, SPEED_ROTATION_DEG_S,
@@ -162,8 +162,10 @@ class ArmCore(SoftLimitWatch, MovePlanning):
 
     @returns(*GETTER)
     def get_manip_info(self) -> Reply:
+        """cmd_cycle is the control period in whole ms (ULONG), at least 1: a period under
+        1 ms (rate_hz up to 2000) is not a command cycle of none."""
         period_ms = self.executor.dt * 1000.0
-        cycle_ms = round(period_ms)
+        cycle_ms = max(1, round(period_ms))
         info = ("acti_ros2", "7-axis SRS arm with 1-axis gripper (PyBullet)", self.axis_count,
                 cycle_ms, True)
         comment = ("" if abs(period_ms - cycle_ms) < 1e-9 else
@@ -195,7 +197,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
                               f" got {len(soft_limit)}")
         limits = np.empty((self.axis_count, 2))
         for i, lim in enumerate(soft_limit):
-            upper, lower = _limit_value(lim, f"soft_limit[{i}] (J{i + 1})")
+            upper, lower = _limit_value(lim, f"soft_limit[{i}] (J{i + 1})", pinned=True)
             hlo, hhi = self.hard_limit_joint[i]
             if lower < hlo - 1e-9 or upper > hhi + 1e-9:
                 raise value_error(f"soft_limit[{i}]: [{lower:g}, {upper:g}]° is outside J{i + 1}'s "
@@ -222,7 +224,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
 
     @returns(*GETTER)
     def get_base_offset(self) -> dict:
-        return {"offset": pose_to_hg(self.frames.base)}
+        return {"offset": list(self.frames.base_hg)}
 
     @returns(*GETTER)
     def get_max_speed_cartesian(self) -> dict:
@@ -338,7 +340,8 @@ class ArmCore(SoftLimitWatch, MovePlanning):
         100 mm from where the new frame said it should."""
         base = _offset(offset, BASE_OFFSET_MM, ReturnCode.VALUE_ERR)
         self._set_while_idle("set_base_offset", R.NG, "its target is in the present robot frame",
-                             lambda: setattr(self, "frames", Frames(base, self.frames.tool)))
+                             lambda: setattr(self, "frames",
+                                             self.frames.with_base(base, hg_as_set(base, offset))))
 
     @returns(R.STATUS_ERR)
     def set_control_point_offset(self, offset: list[float]) -> None:
@@ -348,7 +351,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
         tool = _offset(offset, CONTROL_POINT_OFFSET_MM, ReturnCode.NG)
         self._set_while_idle("set_control_point_offset", R.STATUS_ERR,
                              "it was planned for the present control point",
-                             lambda: setattr(self, "frames", Frames(self.frames.base, tool)))
+                             lambda: setattr(self, "frames", self.frames.with_tool(tool)))
 
     def _set_while_idle(self, name: str, code: ReturnCode, why: str,
                         apply: Callable[[], None]) -> None:
@@ -404,9 +407,8 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     @plans
     def move_ptp_joint_abs(self, joint_points: list[float]) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
-        goal = np.radians(finite_vector(joint_points, self.axis_count, "joint_points"))
-        self._check_joint_target(np.degrees(goal), "move_ptp_joint_abs")   # before the queue
-        return self.queue_joint_move(lambda start: goal, "move_ptp_joint_abs")
+        goal = finite_vector(joint_points, self.axis_count, "joint_points")
+        return self._queue_joint_target(goal, "move_ptp_joint_abs")
 
     @returns(*MOVE)
     @plans
@@ -421,15 +423,21 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     @plans
     def go_home(self) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
-        goal = np.radians(self.home)
-        return self.queue_joint_move(lambda start: goal, "go_home")
+        return self._queue_joint_target(self.home, "go_home")
+
+    def _queue_joint_target(self, goal_deg: np.ndarray, label: str) -> dict:
+        """A PTP move to an absolute target (degree), checked against the soft limits before
+        the queue is looked at: a full queue would have hidden that it is wrong from any start."""
+        self._check_joint_target(goal_deg, label)
+        goal = np.radians(goal_deg)
+        return self.queue_joint_move(lambda start: goal, label)
 
     @returns(*MOVE)
     @plans
     def move_ptp_cartesian_abs(self, car_point: tuple) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
         target, psi = _car_point(car_point, "car_point")
-        self._check_target(target, "move_ptp_cartesian_abs")
+        self._check_target(target, "move_ptp_cartesian_abs", psi=psi)
         return self._queue_ptp_cartesian(lambda P0: target, "move_ptp_cartesian_abs", psi=psi)
 
     @returns(*MOVE)
@@ -437,6 +445,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     def move_ptp_cartesian_rel(self, car_point: tuple) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
         delta, turn = _car_point(car_point, "car_point")
+        self._check_step(delta, "move_ptp_cartesian_rel")
         return self._queue_ptp_cartesian(lambda P0: compose_relative(P0, delta),
                                          "move_ptp_cartesian_rel", turn=turn)
 
@@ -445,7 +454,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     def move_linear_cartesian_abs(self, car_point: tuple) -> dict:
         self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
         target, psi = _car_point(car_point, "car_point")
-        self._check_target(target, "move_linear_cartesian_abs")
+        self._check_target(target, "move_linear_cartesian_abs", psi=psi)
         return self.queue_cartesian(lambda P0: LinePath(P0, target), "move_linear_cartesian_abs",
                                      psi=psi)
 
@@ -454,6 +463,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     def move_linear_cartesian_rel(self, car_point: tuple) -> dict:
         self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
         delta, turn = _car_point(car_point, "car_point")
+        self._check_step(delta, "move_linear_cartesian_rel")
         return self.queue_cartesian(lambda P0: LinePath(P0, compose_relative(P0, delta)),
                                      "move_linear_cartesian_rel", turn=turn)
 
@@ -466,7 +476,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
         via, _ = _car_point(car_point_r, "car_point_r")
         target, psi = _car_point(car_point_t, "car_point_t")
         self._check_target(via, "move_circular_cartesian_abs: car_point_r")
-        self._check_target(target, "move_circular_cartesian_abs")
+        self._check_target(target, "move_circular_cartesian_abs", psi=psi)
         return self.queue_cartesian(lambda P0: ArcPath(P0, via[:3, 3], target),
                                      "move_circular_cartesian_abs", psi=psi)
 
@@ -476,6 +486,8 @@ class ArmCore(SoftLimitWatch, MovePlanning):
         self._check_can_move(self.speed_cartesian, "set_speed_cartesian")
         via, _ = _car_point(car_point_r, "car_point_r")
         delta, turn = _car_point(car_point_t, "car_point_t")
+        self._check_step(via, "move_circular_cartesian_rel: car_point_r")
+        self._check_step(delta, "move_circular_cartesian_rel")
         return self.queue_cartesian(
             lambda P0: ArcPath(P0, P0[:3, 3] + via[:3, 3], compose_relative(P0, delta)),
             "move_circular_cartesian_rel", turn=turn)
@@ -494,7 +506,9 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     @returns(R.STATUS_ERR, R.VALUE_ERR, R.NOT_SV_ON_ERR)
     @plans
     def move_gripper(self, angle_ratio: int) -> dict:
-        """The spec lists no FULL_MOTION_QUEUE_ERR here: a full queue is STATUS_ERR."""
+        """The spec lists no FULL_MOTION_QUEUE_ERR here: a full queue is STATUS_ERR. The state
+        is answered before the argument, as by every motion command."""
+        self._check_can_move()
         ratio = ratio_percent(angle_ratio, "angle_ratio")
         try:
             return self.queue_gripper(ratio, "move_gripper")

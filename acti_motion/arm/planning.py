@@ -87,20 +87,34 @@ class MovePlanning:
                                   f"[{a:g}, {b:g}]°")
 
     def _check_joint_step(self, step_deg: np.ndarray, name: str) -> None:
-        """A relative move wider than a joint's soft-limit range leaves it from any start:
-        VALUE_ERR before the queue is looked at (a full queue would have hidden it)."""
-        span = (self.soft_limit_joint[:, 1] - self.soft_limit_joint[:, 0]).tolist()
-        for i, (d, w) in enumerate(zip(np.asarray(step_deg, float).tolist(), span)):
-            if abs(d) > w + 1e-9:
-                raise value_error(f"{name}: J{i + 1} by {d:g}° leaves the soft limit from any "
-                                  f"start (its range is {w:g}°)")
+        """A relative step that takes no start within the hardware range into the soft limits
+        is VALUE_ERR before the queue is looked at (a full queue would have hidden it). Only
+        that: the arm may rest outside soft limits set since, and a step back in is a move."""
+        soft, hard = self.soft_limit_joint, self.hard_limit_joint
+        lowest, highest = (soft[:, 0] - hard[:, 1]).tolist(), (soft[:, 1] - hard[:, 0]).tolist()
+        for i, (d, lo, hi) in enumerate(zip(np.asarray(step_deg, float).tolist(), lowest, highest)):
+            if not lo - 1e-9 <= d <= hi + 1e-9:
+                raise value_error(f"{name}: J{i + 1} by {d:g}° leaves the soft limit "
+                                  f"[{soft[i, 0]:g}, {soft[i, 1]:g}]° from any start within its "
+                                  f"range [{hard[i, 0]:g}, {hard[i, 1]:g}]°")
 
-    def _check_target(self, target: np.ndarray, label: str, frames: Frames | None = None) -> None:
-        """A target (4×4, m) within the Cartesian soft limit and the arm's reach, else VALUE_ERR.
-        Absolute targets are checked before the queue is looked at (a full queue would have
-        hidden it), and again when planned, with the frames in force then."""
+    def _check_target(self, target: np.ndarray, label: str, frames: Frames | None = None,
+                      psi: float | None = None) -> None:
+        """A target (4×4, m) within the Cartesian soft limit and the arm's reach and, given its
+        elbow `psi` (rad), one a joint solution within the joint soft limits reaches, else
+        VALUE_ERR. None of this depends on the start (IK tries all eight branches): absolute
+        targets are checked before the queue is looked at (a full queue would have hidden it),
+        and again when planned, with the frames in force then."""
+        frames = self.frames if frames is None else frames
         self._check_cartesian_positions(target[None, :3, 3] * 1000.0, label)
-        self._check_reach(target[None, :3, 3], self.frames if frames is None else frames, label)
+        self._check_reach(target[None, :3, 3], frames, label)
+        if psi is not None:
+            lim = np.radians(self.soft_limit_joint)
+            try:
+                self.kin.solve(frames.flange_of(target), self.device.queued_end.joints, psi=psi,
+                               lower=lim[:, 0], upper=lim[:, 1])
+            except Unreachable as e:
+                raise value_error(f"{label}: {e}") from None
 
     def _check_reach(self, positions: np.ndarray, frames: Frames, label: str) -> None:
         """Control-point positions (robot frame, m) no farther from the shoulder than the arm,
@@ -109,7 +123,7 @@ class MovePlanning:
         kin = self.kin
         to_robot = inverse(frames.base)
         shoulder = to_robot[:3, :3] @ kin.shoulder + to_robot[:3, 3]
-        radius = kin.reach + kin.hand + float(np.linalg.norm(frames.tool[:3, 3]))
+        radius = self.planner.reach_radius(frames)
         dist = np.linalg.norm(positions - shoulder, axis=1)
         far = np.flatnonzero(~(dist <= radius + 1e-9))
         if len(far):
@@ -118,6 +132,15 @@ class MovePlanning:
                      f"the path at {100.0 * k / max(1, len(positions) - 1):.0f} %")
             raise value_error(f"{label}: {where} is out of reach: {dist[k] * 1e3:.6g} mm from the "
                               f"shoulder, the arm reaches {radius * 1e3:.1f} mm")
+
+    def _check_step(self, delta: np.ndarray, label: str) -> None:
+        """A relative step (4×4, m) longer than the reach's ball is wide ends out of reach from
+        any start: VALUE_ERR before the queue is looked at (a full queue would have hidden it)."""
+        diameter = 2.0 * self.planner.reach_radius(self.frames)
+        step = float(np.linalg.norm(delta[:3, 3]))
+        if step > diameter + 1e-9:
+            raise value_error(f"{label}: a step of {step * 1e3:.6g} mm is out of reach from any "
+                              f"start: the arm reaches {diameter * 1e3:.1f} mm across")
 
     def _check_cartesian_positions(self, positions_mm: np.ndarray, label: str) -> None:
         lim = self.soft_limit_cartesian

@@ -15,6 +15,7 @@ import pinocchio as pin
 from acti_motion.replies import Refused, ReturnCode, finite_vector
 
 ROTATION_TOLERANCE = 1e-3
+EXACT_ROTATION = 1e-15      # |RᵀR − I| of a rotation kept as given (one a getter answered)
 _ORIGIN = np.zeros(3)
 
 
@@ -42,8 +43,10 @@ def hg_to_pose(values: Iterable[float], name: str,
         raise Refused(code, f"{name}: the 3×3 part is not a rotation (orthonormal, det +1): "
                             f"|RᵀR − I| = {err:.3g}, det = {np.linalg.det(R):.3g}")
     T = np.eye(4)
-    u, _, vt = np.linalg.svd(R)
-    T[:3, :3] = u @ vt
+    if err > EXACT_ROTATION:             # made orthonormal; an exact one keeps its last digits
+        u, _, vt = np.linalg.svd(R)
+        R = u @ vt
+    T[:3, :3] = R
     T[:3, 3] = m[:, 3] / 1000.0
     return T
 
@@ -52,6 +55,14 @@ def pose_to_hg(T: np.ndarray) -> list[float]:
     m = np.array(T[:3, :4], dtype=float)
     m[:, 3] *= 1000.0
     return [float(x) for x in m.reshape(-1)]
+
+
+def hg_as_set(T: np.ndarray, values: Iterable[float]) -> list[float]:
+    """The HgMatrix of pose T (from `values` by hg_to_pose) with the translation exactly as
+    given in `values`: mm → m → mm is not exact (-1023.3 came back as -1023.2999999999998)."""
+    hg = pose_to_hg(T)
+    hg[3::4] = [float(x) for x in list(values)[3::4]]
+    return hg
 
 
 def inverse(T: np.ndarray) -> np.ndarray:
@@ -87,10 +98,20 @@ class Frames:
     """The two offsets of the middle-level port: `base` = the robot frame seen from the arm frame
     (setBaseOffset), `tool` = the control point seen from the flange (setControlPointOffset)."""
 
-    def __init__(self, base: np.ndarray | None = None, tool: np.ndarray | None = None) -> None:
+    def __init__(self, base: np.ndarray | None = None, tool: np.ndarray | None = None,
+                 base_hg: list[float] | None = None) -> None:
         self.base = np.eye(4) if base is None else base
         self.tool = np.eye(4) if tool is None else tool
+        self.base_hg = pose_to_hg(self.base) if base_hg is None else base_hg   # as set
         self._base_inv, self._tool_inv = inverse(self.base), inverse(self.tool)
+
+    def with_base(self, base: np.ndarray, base_hg: list[float]) -> "Frames":
+        """These frames with another base offset, `base_hg` being it as set (getBaseOffset)."""
+        return Frames(base, self.tool, base_hg)
+
+    def with_tool(self, tool: np.ndarray) -> "Frames":
+        """These frames with another control-point offset (the base offset kept as set)."""
+        return Frames(self.base, tool, self.base_hg)
 
     def flange_of(self, P: np.ndarray) -> np.ndarray:
         """Flange pose (arm frame) that puts the control point at P (robot frame)."""

@@ -90,16 +90,19 @@ def _offset(offset: list[float], bound_mm: float, code: ReturnCode) -> np.ndarra
     return pose
 
 
-def _limit_value(lim: Any, name: str) -> tuple[float, float]:
-    """(upper, lower) of a LimitValue, finite and upper >= lower, else VALUE_ERR."""
+def _limit_value(lim: Any, name: str, pinned: bool = False) -> tuple[float, float]:
+    """(upper, lower) of a LimitValue, finite and upper > lower (or, with `pinned`, upper =
+    lower too: the common port refuses only upper < lower for a joint, which may be held at one
+    value), else VALUE_ERR."""
     if isinstance(lim, dict):
         lim = (lim.get("upper"), lim.get("lower"))
     if len(lim) != 2:
         raise value_error(f"{name} needs upper and lower")
     upper = finite_number(lim[0], f"{name}.upper")
     lower = finite_number(lim[1], f"{name}.lower")
-    if upper <= lower:
-        raise value_error(f"{name}: upper {upper:g} must be above lower {lower:g}")
+    if upper < lower or upper == lower and not pinned:
+        below = "at or above" if pinned else "above"
+        raise value_error(f"{name}: upper {upper:g} must be {below} lower {lower:g}")
     return upper, lower
 
 

@@ -303,13 +303,18 @@ class CartesianPlanner:
         timing = time_optimal(spline.ss, spline.qs, extents, limits)
         return CartesianPlan(spline, timing, True)
 
+    def reach_radius(self, frames: Frames) -> float:
+        """Radius (m) of the ball about the shoulder that holds every control point the arm
+        reaches: arm, hand and the control-point offset."""
+        return self.kin.reach + self.kin.hand + float(np.linalg.norm(frames.tool[:3, 3]))
+
     def check_length(self, path: CartesianPath, frames: Frames) -> None:
         """Unreachable when `path` (a line or arc of this module) is longer than any path within
         the arm's reach: every control point lies within reach + hand + the control-point
         offset of the shoulder, and no line or arc inside a ball of radius r is longer than 2πr.
         This bounds every sampling of what is accepted (an arc through a via point almost on
         the line runs the long way round a huge circle)."""
-        radius = self.kin.reach + self.kin.hand + float(np.linalg.norm(frames.tool[:3, 3]))
+        radius = self.reach_radius(frames)
         if _own(path) and path.length > 2 * math.pi * radius:
             raise Unreachable(f"out of reach: the path is {path.length * 1e3:.0f} mm long, and no "
                               f"path within the arm's reach is longer than "
