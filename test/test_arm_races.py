@@ -12,7 +12,7 @@ from acti_motion.executor import MotionExecutor
 from acti_motion.replies import ReturnCode as R
 from acti_sim.world import World
 from arm_fixtures import IDENTITY, arm, rest  # noqa: F401
-from sim_fixtures import executor, run_until  # noqa: F401
+from sim_fixtures import Announced, executor, run_until  # noqa: F401
 from trajectory_check import ArmTrace
 
 TOOL = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 100.0]
@@ -57,20 +57,6 @@ def while_planning(arm, act):
     held.release.set()
     thread.join(30.0)
     return out["reply"]
-
-
-class Announced:
-    """A lock that says (`waits`) when a thread comes to take it."""
-
-    def __init__(self, lock) -> None:
-        self.lock, self.waits = lock, threading.Event()
-
-    def __enter__(self):
-        self.waits.set()
-        return self.lock.__enter__()
-
-    def __exit__(self, *exc):
-        return self.lock.__exit__(*exc)
 
 
 def while_b_waits_for_a(arm, act):
