@@ -217,7 +217,8 @@ class Device:
         The rate falls linearly, so the motion's clock advances rate² · ramp / 2 more seconds: the
         rest point is known now and becomes the start of whatever is queued next. A stop while
         one decelerates keeps the shorter ramp and computes the rest point again from the rate
-        now, so the clock never jumps to a rest point meant for another ramp.
+        now, so the clock never jumps to a rest point meant for another ramp. An infinite ramp
+        keeps the rate: the motion runs on at its pace to its end, the rest point.
         """
         with self.lock:
             self._reason = reason
