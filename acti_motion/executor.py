@@ -162,13 +162,11 @@ class Device:
                 with self.lock:
                     if len(self.queue) + len(plans) > self.capacity:
                         return None
-                    if self.stopped_since(arrived):
-                        if self._stop_at is None:
-                            return [self._accept_discarded() for _ in plans]
-                    elif generation != self.generation:
+                    if generation != self.generation or self.stopped_since(arrived):
                         if self.current is None and not self.queue:
                             return [self._accept_discarded() for _ in plans]
-                        continue            # a halt's own motion runs: plan again from its end
+                        if self._stop_at is None:
+                            continue        # a halt's own motion runs: plan again from its end
                     ids = []
                     for motion, (_, label) in zip(motions, plans):
                         self.last_id += 1
