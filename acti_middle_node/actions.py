@@ -6,8 +6,9 @@ both running at once are bounded (`max_action_goals`) and more are rejected.
 """
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable
 
 from acti_msgs.action import Move, WaitMotion
 from acti_msgs.msg import ReturnId
@@ -54,6 +55,7 @@ class MotionActions:
     def __init__(self, plane: Plane, core: ArmCore, config: ActionConfig) -> None:
         self.core, self.config = core, config
         self.watch = device_watch(plane, core.device, 1.0 / config.feedback_rate_hz)
+        self._planner = ThreadPoolExecutor(1, thread_name_prefix="acti-move-goals")
         slots = GoalSlots(plane.owner, config.max_action_goals, "max_action_goals")
         cancel = accept_cancel(self.watch)
         self.servers = [
@@ -87,7 +89,7 @@ class MotionActions:
                                                 + ", ".join(MOVE_KINDS))
         else:
             kwargs = {name: to_core(getattr(goal, field)) for name, field in fields}
-            reply = getattr(self.core, goal.kind)(**kwargs)
+            reply = await self._off_plane(lambda: getattr(self.core, goal.kind)(**kwargs))
         result.return_id = return_id(reply)
         if not reply.ok:
             goal_handle.abort()
@@ -122,6 +124,17 @@ class MotionActions:
         else:
             goal_handle.succeed()
         return result
+
+    async def _off_plane(self, move: Callable[[], Reply]) -> Reply:
+        """move() (a core operation: it answers, never raises) on the goals' planning thread,
+        awaited without holding the goal plane's one thread: a move plans for milliseconds and
+        waits for any plan under way (the accept lock) for as long as that takes, and every
+        other goal's acceptance, feedback, cancel and result waited with it. One thread, so
+        that the moves of goals are queued in the order the goals came."""
+        planned = self._planner.submit(move)
+        planned.add_done_callback(lambda _: self.watch.poke())
+        return await self.watch.until(lambda: planned.result() if planned.done() else None,
+                                      lambda: None)
 
     def _where(self, result: Move.Result) -> None:
         fill(result, {"joint_pos": self.core.get_feedback_pos_joint().values["pos"],

@@ -93,6 +93,7 @@ class Device:
         self._rate_target = 1.0
         self._ramp = 1.0
         self._stop_at: float | None = None
+        self._stops = 0            # stops asked for (`arrival`, `stopped_since`)
         self.paused = False
         self.generation = 0
         self.revision = 0          # bumped whenever the motions change, except by time passing
@@ -144,8 +145,10 @@ class Device:
         the vehicle's 停止後は全ての動作指令を廃棄): motions that arrive while a stop decelerates,
         or whose planning a stop (or halt) overtook, are accepted (they get ids) and discarded
         when the device comes to rest, or at once when it already rests; `was_discarded(id)`
-        says so, and nothing of them runs.
+        says so, and nothing of them runs. They arrive when this is called: planned, or waiting
+        for another's plan, across the end of a stop, they were queued after it and ran.
         """
+        arrived = self.arrival()
         with self._accept:
             while True:
                 with self.lock:
@@ -159,7 +162,7 @@ class Device:
                 with self.lock:
                     if len(self.queue) + len(plans) > self.capacity:
                         return None
-                    if generation != self.generation:
+                    if generation != self.generation or self.stopped_since(arrived):
                         if self.current is None and not self.queue:
                             return [self._accept_discarded() for _ in plans]
                         if self._stop_at is None:
@@ -174,6 +177,16 @@ class Device:
                         self.queued_end = self._end_of_queue()
                     self.changed.notify_all()
                     return ids
+
+    def arrival(self) -> int:
+        """A mark of now for `stopped_since`: a stop that decelerates now counts as one to come
+        (what arrives during its deceleration is discarded with what came before it)."""
+        with self.lock:
+            return self._stops - (self._stop_at is not None)
+
+    def stopped_since(self, mark: int) -> bool:
+        """A stop came after `arrival()` gave `mark`, or was decelerating then."""
+        return self._stops != mark
 
     def pause(self, ramp: float, idle: bool = True) -> bool:
         """Decelerate over `ramp` seconds and hold (also what is queued and not yet started);
@@ -202,10 +215,12 @@ class Device:
         The rate falls linearly, so the motion's clock advances rate² · ramp / 2 more seconds: the
         rest point is known now and becomes the start of whatever is queued next. A stop while
         one decelerates keeps the shorter ramp and computes the rest point again from the rate
-        now, so the clock never jumps to a rest point meant for another ramp.
+        now, so the clock never jumps to a rest point meant for another ramp. An infinite ramp
+        keeps the rate: the motion runs on at its pace to its end, the rest point.
         """
         with self.lock:
             self._reason = reason
+            self._stops += 1
             self._discard_pending()
             cur = self.current
             if cur is None:

@@ -1,6 +1,8 @@
 """ROS-free fixtures: a real PyBullet world and executor, stepped by the test itself."""
 from __future__ import annotations
 
+import threading
+
 import pytest
 
 from acti_motion.executor import MotionExecutor
@@ -15,6 +17,20 @@ def run_until(executor: MotionExecutor, predicate, max_seconds: float) -> float:
             raise AssertionError(f"condition not reached in {max_seconds} simulated s")
         executor.step()
     return executor.world.time - t0
+
+
+class Announced:
+    """A lock that says (`waits`) when a thread comes to take it."""
+
+    def __init__(self, lock) -> None:
+        self.lock, self.waits = lock, threading.Event()
+
+    def __enter__(self):
+        self.waits.set()
+        return self.lock.__enter__()
+
+    def __exit__(self, *exc):
+        return self.lock.__exit__(*exc)
 
 
 @pytest.fixture

@@ -12,7 +12,7 @@ from acti_motion.executor import MotionExecutor
 from acti_motion.replies import ReturnCode as R
 from acti_sim.world import World
 from arm_fixtures import IDENTITY, arm, rest  # noqa: F401
-from sim_fixtures import executor, run_until  # noqa: F401
+from sim_fixtures import Announced, executor, run_until  # noqa: F401
 from trajectory_check import ArmTrace
 
 TOOL = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 100.0]
@@ -57,6 +57,24 @@ def while_planning(arm, act):
     held.release.set()
     thread.join(30.0)
     return out["reply"]
+
+
+def while_b_waits_for_a(arm, act):
+    """act() (true) while move B waits for the accept lock that move A holds while it plans;
+    the replies of A and B."""
+    out = {}
+
+    def b_waits():
+        announced = arm.device._accept = Announced(arm.device._accept)
+        b = threading.Thread(target=lambda: out.setdefault(
+            "b", arm.move_ptp_joint_rel([10.0] + [0.0] * 6)))
+        b.start()
+        assert announced.waits.wait(30.0)
+        assert act()
+        out["thread"] = b
+    a = while_planning(arm, b_waits)
+    out["thread"].join(30.0)
+    return a, out["b"]
 
 
 # --- pause ------------------------------------------------------------------------------------
@@ -156,25 +174,9 @@ def test_a_move_waiting_for_another_plan_is_refused_after_servo_off(arm, executo
     """B passed the servo check, then waited while A planned; servo_off came meanwhile (the arm
     idle): B was queued after that stop and ran with the servo off."""
     start = arm.device.hold.joints.copy()
-    entered, out = threading.Event(), {}
-    submit = arm.device.submit
-
-    def submit_entered(*args, **kwargs):
-        entered.set()
-        return submit(*args, **kwargs)
-
-    def servo_off_while_b_waits():
-        arm.device.submit = submit_entered
-        b = threading.Thread(target=lambda: out.setdefault(
-            "b", arm.move_ptp_joint_rel([10.0] + [0.0] * 6)))
-        b.start()
-        assert entered.wait(30.0)
-        assert arm.servo_off().ok
-        out["thread"] = b
-    a = while_planning(arm, servo_off_while_b_waits)
-    out["thread"].join(30.0)
+    a, b = while_b_waits_for_a(arm, lambda: arm.servo_off().ok)
     assert a.ok and arm.device.was_discarded(a.values["motion_id"])
-    assert out["b"].code == R.NOT_SV_ON_ERR, out["b"]
+    assert b.code == R.NOT_SV_ON_ERR, b
     steps(executor, 250)
     assert not arm.device.busy and np.allclose(arm.device.hold.joints, start)
 
@@ -369,3 +371,31 @@ def test_a_blend_is_watched_strictly_only_on_the_limits_that_changed_between_its
     merged = arm.device.queue[1].motion.limits_checked
     assert np.isnan(merged[3, 1]) and np.isnan(merged).sum() == 1
     assert np.array_equal(np.delete(merged.ravel(), 7), np.delete(first.limits_checked.ravel(), 7))
+
+
+def test_a_move_planned_across_the_end_of_a_stop_is_discarded(arm, executor, trace):  # noqa: F811
+    """Sent while the stop decelerated, planned until after the arm was at rest: it was queued
+    then and ran (5.4.19 discards every command given until the arm is at rest)."""
+    assert arm.move_ptp_joint_rel([20.0] * 7).ok
+    steps(executor, 100)
+    assert arm.stop().ok and arm.device.stopping
+    rest_at = arm.device.queued_end.joints.copy()
+
+    def at_rest():
+        run_until(executor, lambda: not arm.device.busy, 5.0)
+    r = while_planning(arm, at_rest)
+    assert r.ok and r.comment.startswith("discarded: stop"), r
+    steps(executor, 250)
+    assert arm.device.was_discarded(r.values["motion_id"]) and arm.device.completed == 0
+    trace.check_rest(rest_at)
+
+
+def test_a_move_sent_before_a_stop_and_planned_after_it_is_discarded(arm, executor):  # noqa: F811
+    """B waited for A's plan; a stop came (the arm idle, so at rest at once); B was then
+    planned under the stop's new generation, queued and ran: a command given before the stop."""
+    start = arm.device.hold.joints.copy()
+    a, b = while_b_waits_for_a(arm, lambda: arm.stop().ok)
+    assert a.ok and arm.device.was_discarded(a.values["motion_id"])
+    assert b.ok and arm.device.was_discarded(b.values["motion_id"]), b
+    steps(executor, 250)
+    assert not arm.device.busy and np.allclose(arm.device.hold.joints, start)

@@ -1,14 +1,15 @@
 """The base's control plane without ROS: pause, resume and stop checked set-point by set-point
 (trajectory_check_base), also in the window between accept and pick-up and while another thread
 plans; planning never holds a lock that stop, the getters or the simulation need."""
+import math
 import threading
 
 import pytest
 
 from acti_motion.vehicle import cruise
 from acti_motion.vehicle.core import VehicleState
-from sim_fixtures import executor  # noqa: F401
-from vehicle_fixtures import base, position, ready, state, trace  # noqa: F401
+from sim_fixtures import Announced, executor  # noqa: F401
+from vehicle_fixtures import base, position, ready, state, steps, trace  # noqa: F401
 
 MOVES = {
     "move_forward": lambda b: b.move_forward(1500.0),
@@ -166,3 +167,27 @@ def test_servo_off_while_a_move_is_planned_queues_nothing(base, executor, planni
     assert (not r.ok and "Powered" in r.comment) or \
         (r.ok and base.device.was_discarded(r.values["motion_id"]))
     assert not base.device.busy
+
+
+def test_a_move_sent_before_a_stop_and_planned_after_it_is_discarded(base, executor, planning_gate):  # noqa: F811
+    """B waited for the planning lock while A planned; a stop came (the base idle, so at rest
+    at once); B then began under the stop's new generation and ran: a command given before
+    the stop (停止後は全ての動作指令を廃棄)."""
+    entered, gate = planning_gate
+    ready(base)
+    start = position(base)
+    a_thread, a = in_thread(lambda: base.move_cruise_abs((2000.0, 0.0)))
+    assert entered.wait(10.0)
+    announced = base.planning = Announced(base.planning)
+    b_thread, b = in_thread(lambda: base.move_forward(500.0))
+    assert announced.waits.wait(10.0)
+    assert answers_at_once(base.stop).ok
+    gate.set()
+    a_thread.join(10.0)
+    b_thread.join(10.0)
+    for r in (a["reply"], b["reply"]):        # true, and discarded (said, or by its id)
+        assert r.ok and ("discarded" in r.comment
+                         or base.device.was_discarded(r.values["motion_id"])), r
+    steps(executor, 2.0)
+    assert not base.device.busy and base.device.completed == 0
+    assert math.dist(position(base)[:2], start[:2]) < 1.0

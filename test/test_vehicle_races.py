@@ -251,3 +251,40 @@ def test_cruise_points_added_one_by_one_plan_a_window_of_constant_size(base, exe
     for i in range(40, 50):
         assert base.move_cruise_abs((400.0 * (i + 1), 300.0 * (i % 2))).values["motion_id"] == 1
     assert max(sizes[cruise.WINDOW:]) <= cruise.WINDOW + 1
+
+
+# --- pause and stop of a brake ----------------------------------------------------------------
+def braking(base, executor):  # noqa: F811
+    """A fast move given up (a blockage, as the simulation thread declares it): the brake runs."""
+    ready(base)
+    assert base.set_velocity((1000.0, 90.0)).ok and base.move_forward(3000.0).ok
+    run_until(executor, lambda: base.odometry.v > 0.5, 10.0)
+    base._declare_stuck(0.5, 0.0, "could not follow its path")
+    steps(executor, 0.02)
+    assert base.device.current.label == "brake" and base.odometry.v > 0.3
+
+
+def test_pause_then_stop_of_a_brake_brings_the_base_to_rest(base, executor):  # noqa: F811
+    """The pause froze the brake's clock, and with it the wheel speeds it commands: the base
+    rolled on at ~0.4 m/s for ever, Paused, and neither stop nor servo off ended it."""
+    braking(base, executor)
+    assert base.pause().ok
+    steps(executor, 1.0)
+    assert base.stop().ok and base.set_servo(False).ok
+    steps(executor, 2.0)
+    at = position(base)
+    steps(executor, 1.0)
+    assert abs(base.odometry.v) < 0.01 and math.dist(position(base)[:2], at[:2]) < 1.0
+    assert not base.device.busy
+
+
+def test_a_move_given_after_a_stop_while_a_brake_runs_is_discarded(base, executor):  # noqa: F811
+    """停止後は全ての動作指令を廃棄: the stop of a brake discarded only what was queued then,
+    and a move given until the base was at rest ran after the brake."""
+    braking(base, executor)
+    assert base.stop().ok
+    r = base.move_linear_abs((0.0, 0.0, 0.0))
+    assert r.ok and "discarded" in r.comment, r
+    settle(executor, base, 5.0)
+    steps(executor, 1.0)
+    assert base.device.completed == 0 and abs(base.odometry.v) < 0.01

@@ -391,7 +391,8 @@ class RobotHost(Host):
     def _ramp(self, kind: str) -> float:
         """Accel/decel time (s) of a move: the longer of the ACCEL and DECEL settings (the
         profiles are symmetric; one that is not set follows the other), the port's accel time
-        while neither is set."""
+        while neither is set; at most MAX_RAMP, since a stop decelerates over it (ACCEL1 takes
+        any percentage above 0: 0.001 % made 10 000 s, and a stop that never ended)."""
         arm = self.arm
         joint = kind == "joint"
         minimum = arm.min_accel_time_joint if joint else arm.min_accel_time_cartesian
@@ -402,7 +403,8 @@ class RobotHost(Host):
                 return default
             how, value = setting
             return minimum * 100.0 / value if how == "percent" else value
-        return max(of(self.accel or self.decel), of(self.decel or self.accel), minimum)
+        return min(max(of(self.accel or self.decel), of(self.decel or self.accel), minimum),
+                   MAX_RAMP)
 
     def _cartesian_ratio(self) -> float:
         return 100.0 * self.speed / self.arm.max_speed_cartesian[0]

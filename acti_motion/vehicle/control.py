@@ -266,7 +266,13 @@ class Control:
         return ramp
 
     def _stop_ramp(self) -> float:
-        """Time to stop from the present speed at the maximum acceleration."""
+        """Time to stop from the present speed at the maximum acceleration. A brake does so
+        already: pause and stop keep its pace (infinite, the device's rate stays). Time-scaled,
+        its clock froze in a pause and so did the wheel speeds it commands: the base rolled on,
+        Paused, and stop and servo off, which only discarded the queue, could not end it."""
+        cur = self.device.current
+        if cur is not None and isinstance(cur.motion, BrakeMotion):
+            return math.inf
         c = self.config
         return self._ramp((c.accel_limit_translation, c.accel_limit_rotation), up=False)
 
@@ -275,11 +281,8 @@ class Control:
 
     def _stop(self, reason: str = STOPPED) -> None:
         """Decelerate at the maximum acceleration and discard everything, `reason` given to
-        the waits on what is discarded."""
-        cur = self.device.current
-        if cur is not None and isinstance(cur.motion, BrakeMotion):
-            self.device.edit(lambda device: device.discard_queue(reason))
-            return
+        the waits on what is discarded (all that comes until the base is at rest, also while
+        a brake runs)."""
         self.device.stop(self._stop_ramp(), reason)
 
     def _halt(self, reason: str) -> None:

@@ -69,6 +69,7 @@ class VehicleCore(Control, Planning, Sensing):
         self._drive_deadline = math.inf      # time.monotonic() at which a jog/joystick drive ends
         self._deadman_fired: int | None = None
         self._op_generation = 0              # the device's generation when the planning operation began
+        self._op_arrival = 0                 # the device's `arrival()` when it was called
         self.velocity_bounds = ((c.velocity_min_translation, c.velocity_min_rotation),
                                 (c.velocity_limit_translation, c.velocity_limit_rotation))
         self.accel_bounds = ((c.accel_min_translation, c.accel_min_rotation),

@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Any, Callable
+from contextlib import contextmanager
+from typing import Any, Callable, Iterator
 
 from acti_motion.executor import STALE, Device
 from acti_motion.replies import Refused, finite_number
@@ -275,8 +276,7 @@ class Planning:
         Ignored (False) with the joystick off, the servo off, an alarm, or other moves running
         or queued."""
         c = self.config
-        with self.planning:
-            self._op_generation = self.device.generation
+        with self.planning_operation():
             if not self.joystick or self.state() not in SERVO_ON:
                 return False
             if c.joy_enable_button >= 0 and not (c.joy_enable_button < len(buttons)
@@ -296,23 +296,34 @@ class Planning:
             return True
 
     # --- helpers ----------------------------------------------------------------------------
+    @contextmanager
+    def planning_operation(self) -> Iterator[None]:
+        """The planning lock for one operation, which arrives when it is called: a stop that
+        comes after that (also while it waits for another's plan) or decelerates then discards
+        what it commands (`_admit`); one that waited was run after the stop."""
+        arrived = self.device.arrival()
+        with self.planning:
+            self._op_generation, self._op_arrival = self.device.generation, arrived
+            yield
+
     def _require(self, allowed: tuple[VehicleState, ...], operation: str) -> None:
         """The state check before planning. A move given while a stop decelerates is true and
         discarded, as at its commit (`_admit`): a Ready-only one was refused as Busy instead,
         and left the stopped base in Warning-102."""
         with self.lock:
             s = self.state()
-            if self.device.stopping and s in SERVO_ON:
+            if self.device.stopped_since(self._op_arrival) and s in SERVO_ON:
                 raise Discarded(operation)
             self._refuse_unless(s, allowed, operation)
 
     def _admit(self, allowed: tuple[VehicleState, ...], operation: str, device: Device) -> None:
         """The check a planned motion passes when it is committed (after planning): still in
-        an allowed state; and if a stop decelerates, or came in since the operation began, it
-        is discarded (stop discards every motion command). Takes no lock, so that it can run
-        inside the device's."""
+        an allowed state; and if a stop decelerated when the operation arrived or came since,
+        or a halt came since it began, it is discarded (stop discards every motion command).
+        Takes no lock, so that it can run inside the device's."""
         s = self.state()
-        if (device.stopping or device.generation != self._op_generation) and s in SERVO_ON:
+        if (device.stopped_since(self._op_arrival) or device.generation != self._op_generation) \
+                and s in SERVO_ON:
             raise Discarded(operation)
         self._refuse_unless(s, allowed, operation)
 

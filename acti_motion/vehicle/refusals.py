@@ -49,9 +49,7 @@ def _operation(clears_warnings: bool, planning: bool = False) -> Callable[[Calla
     def decorate(fn: Callable[..., Any]) -> Callable[..., Any]:
         @functools.wraps(fn)
         def recorded(self: "VehicleCore", *args: Any, **kwargs: Any) -> Any:
-            with (self.planning if planning else self.lock):
-                if planning:
-                    self._op_generation = self.device.generation
+            with (self.planning_operation() if planning else self.lock):
                 try:
                     out = fn(self, *args, **kwargs)
                 except Refused as r:

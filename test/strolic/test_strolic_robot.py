@@ -10,6 +10,7 @@ import pytest
 
 from acti_motion.arm.core import ArmConfig, ArmCore
 from acti_motion.executor import MotionExecutor
+from acti_motion.programs.robot import MAX_RAMP
 from acti_motion.programs.run import (RESULT_CHARS, RESULT_ITEM, ProgramRun, Status, shown_output,
                                       shown_stack)
 from acti_sim.world import World
@@ -361,6 +362,24 @@ def test_speed_and_acceleration_settings_time_the_moves(arm, executor, settings,
     assert result.status is Status.FINISHED, result.report
     seconds = max(move[1] / ratio, ramp) + ramp
     assert int(result.stack[-1].split(":")[-1]) / 1000.0 == pytest.approx(seconds, abs=0.02)
+
+
+@pytest.mark.parametrize("setting", ["0.001 ACCEL1", "0.001 DECEL1"])
+def test_a_stop_ends_a_move_of_the_smallest_acceleration_within_the_longest_ramp(
+        arm, executor, setting):  # noqa: F811
+    """ACCEL1/DECEL1 take any percentage above 0: 0.001 % made a ramp of 10 000 s, over which
+    a stop decelerated; the arm never came to rest and every later move was discarded. A stop
+    takes at most MAX_RAMP (the longest ramp ACCEL2 and the ports allow)."""
+    stopped = []
+
+    def hook():
+        if not stopped and arm.device.busy:
+            stopped.append(executor.world.time)
+            assert arm.stop().ok
+    result = run(arm, executor, f"50 JSPEED DROP {setting} DROP {J7_60[0]} DROP -1 $WAIT",
+                 hook=hook)
+    assert result.status is Status.EXCEPTION and result.error.kind is K.ROBOT_ERROR
+    assert not arm.device.busy and executor.world.time - stopped[0] <= MAX_RAMP + 0.1
 
 
 def test_a_pose_sequence_with_a_refused_pose_queues_none_of_it(arm, executor):  # noqa: F811
