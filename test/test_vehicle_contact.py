@@ -134,3 +134,28 @@ def test_switching_the_sensor_on_again_while_locked_lets_the_base_back_away(base
     assert base.unlock().ok
     steps(executor, 0.1)
     assert state(base) == VehicleState.READY and base.move_forward(-200.0).ok
+
+
+def test_a_pause_during_the_brake_after_a_contact_brings_the_base_to_rest(base, executor):  # noqa: F811
+    """1.4.22 pause: 動作中の場合は，まず設定された最大加速度で停止し，完全停止後に一時停止状態.
+    A brush of the bumper at 800 mm/s, unlocked at once, then a pause: the pause froze the
+    brake's clock, so its wheels kept turning at the speed they had (272 mm/s for ever) while
+    the state said Paused."""
+    ready(base)
+    base.set_velocity((800.0, 45.0))
+    assert base.set_digital_sensor_lock(True).ok
+    base.move_forward(5000.0)
+    run_until(executor, lambda: base.odometry.v > 0.79, 5.0)
+    world, touching = executor.world, iter([True])
+    world.bumper_in_contact = lambda: next(touching, False)     # brushed past something light
+    executor.step()
+    assert state(base) == VehicleState.LOCKED
+    assert base.unlock().ok and base.pause().ok
+    steps(executor, 1.5)                                        # 0.8 s to rest at 1000 mm/s²
+    assert state(base) == VehicleState.PAUSED and abs(base.odometry.v) < 5e-3
+    x = position(base)[0]
+    steps(executor, 1.0)
+    assert position(base)[0] == pytest.approx(x, abs=1.0)
+    assert base.resume().ok
+    settle(executor, base, 2.0)
+    assert state(base) == VehicleState.READY and position(base)[0] == pytest.approx(x, abs=5.0)

@@ -551,7 +551,10 @@ class TrackedBaseMotion:
 
 class BrakeMotion:
     """Stop the wheels from their measured speeds at the given decelerations, without a reference
-    pose (after a contact or a blockage); the set-point is wherever odometry says the base is."""
+    pose (after a contact or a blockage); the set-point is wherever odometry says the base is.
+
+    The brake runs on the world's clock, not the device's: a pause slows the device's clock to
+    a halt, which froze the brake with its wheels still turning (pause: 最大加速度で停止し)."""
 
     SETTLE = 0.1
 
@@ -562,6 +565,7 @@ class BrakeMotion:
         self.ramp = max(abs(self.v0) / decel[0], abs(self.w0) / decel[1], 1e-3)
         self.duration = self.ramp + self.SETTLE
         self.error = (0.0, 0.0)
+        self._began: float | None = None     # world time at which the brake's clock was 0
 
     def at(self, t: float) -> Pose2D:
         return self.odometry.pose
@@ -570,7 +574,9 @@ class BrakeMotion:
         """Nothing to move: the set-point is the odometry itself."""
 
     def apply(self, world: World, t: float, rate: float) -> None:
-        k = max(0.0, 1.0 - t / self.ramp)
+        if self._began is None:
+            self._began = world.time - t
+        k = max(0.0, 1.0 - (world.time - self._began) / self.ramp)
         v, w = self.v0 * k, self.w0 * k
         r, b = self.odometry.r, self.odometry.b
         world.set_wheel_velocities((v - w * b / 2) / r, (v + w * b / 2) / r)
