@@ -215,12 +215,13 @@ class Control:
     @command
     def pause(self) -> Reply | None:
         """Decelerate at the maximum acceleration and hold; the queue stays, new motions queue.
-        Ignored (still true, with a comment) where no motion can run: Unpowered, Powered,
+        Given while a stop decelerates, it holds once the base is at rest (完全停止後に一時停止
+        状態). Ignored (still true, with a comment) where no motion can run: Unpowered, Powered,
         Alarm, Locked; switching the servo off ends a pause."""
         s = self.state()
         if s not in SERVO_ON:
             return Reply(comment=f"ignored: the base is {STATE_STRINGS[s]}, there is nothing to pause")
-        self.device.pause(self._stop_ramp())
+        self.device.pause(self._stop_ramp(), after_stop=True)
         return None
 
     @command
