@@ -69,9 +69,10 @@ class Control:
 
     @command
     def set_power(self, on_off: bool) -> None:
-        """Main power; switching it off stops the base and drops the servo. On is refused while
-        the battery is below its cut-off (with the hysteresis band)."""
-        if on_off and self._battery_empty.update(self.battery.voltage):
+        """Main power; switching it off stops the base and drops the servo. Switching on is
+        refused while the battery is below its cut-off (with the hysteresis band); power that
+        is on already stays on, true (偽 = 主回路電源投入に失敗: nothing failed)."""
+        if on_off and not self.power and self._battery_empty.update(self.battery.voltage):
             raise VehicleRefused(AlarmCode.WRONG_STATE,
                                  f"the battery is at {self.battery.voltage:.1f} V, below the cut-off "
                                  f"{self.config.battery_cutoff_voltage:g} V + "
