@@ -434,6 +434,8 @@ class Device:
         else:
             self.completed += 1
         self.current = None
+        if not self.queue:          # where it rests, as measured (a brake's end was a forecast)
+            self.queued_end = self.hold
         self.revision += 1
         self.changed.notify_all()
         self._announce_retired()

@@ -566,9 +566,19 @@ class BrakeMotion:
         self.duration = self.ramp + self.SETTLE
         self.error = (0.0, 0.0)
         self._began: float | None = None     # world time at which the brake's clock was 0
+        self._now: float | None = None       # world time of the last step applied
 
     def at(self, t: float) -> Pose2D:
-        return self.odometry.pose
+        """Where the base comes to rest: the measured pose moved on by what is left of the brake
+        (an arc: both speeds fall together). A move queued behind the brake starts there; from
+        the pose at its planning it started short by the braking distance and went Stuck."""
+        k = self._left(self._now)
+        left = self.ramp * k * k / 2
+        return ConstantTwist(self.odometry.pose, (self.v0 * left, self.w0 * left), 1.0).pose(1.0)
+
+    def _left(self, now: float | None) -> float:
+        """The fraction of the start speeds commanded at world time `now` (None: not begun)."""
+        return 1.0 if now is None else max(0.0, 1.0 - (now - self._began) / self.ramp)
 
     def move_frame(self, frame: Pose2D) -> None:
         """Nothing to move: the set-point is the odometry itself."""
@@ -576,7 +586,8 @@ class BrakeMotion:
     def apply(self, world: World, t: float, rate: float) -> None:
         if self._began is None:
             self._began = world.time - t
-        k = max(0.0, 1.0 - (world.time - self._began) / self.ramp)
+        self._now = world.time
+        k = self._left(self._now)
         v, w = self.v0 * k, self.w0 * k
         r, b = self.odometry.r, self.odometry.b
         world.set_wheel_velocities((v - w * b / 2) / r, (v + w * b / 2) / r)
