@@ -100,11 +100,12 @@ class Control:
         self.servo = bool(on_off)
 
     def _remedy(self, code: int) -> str:
-        """What ends a fault: unlock for a contact, a charged battery for the cut-off."""
+        """What ends an alarm: unlock for a contact, a charged battery for the battery's."""
         if code == AlarmCode.CONTACT:
             return "unlock"
-        if code == AlarmCode.BATTERY_EMPTY:
-            level = self._battery_empty
+        level = {AlarmCode.BATTERY_EMPTY: self._battery_empty,
+                 AlarmCode.BATTERY_LOW: self._battery_low}.get(code)
+        if level is not None:
             return f"the battery is back at {level.level + level.band:g} V and clear_alarm is called"
         return "clear_alarm"
 
@@ -117,14 +118,20 @@ class Control:
 
     # --- alarms -----------------------------------------------------------------------------
     @command
-    def clear_alarm(self) -> None:
+    def clear_alarm(self) -> Reply | None:
         """Clear every alarm (1.4.1: 発生した全てのアラームを解除). One whose cause is still there
         is raised again at once: a battery still within its hysteresis band of the level. Stuck
         ends; Locked is a state that only unlock leaves, and its contact fault stays with it (a
-        client would see a locked base with no alarm to say why)."""
+        client would see a locked base with no alarm to say why). The reply (always true) says
+        which alarms are still active and what ends each."""
         self.alarms.clear(*(k for k in Kind if not (k is Kind.CONTACT and self.locked)))
         self.stuck = False
         self._check_battery(self.battery.voltage)
+        left = self.alarms.active()
+        if not left:
+            return None
+        return Reply(comment="still active: " + "; ".join(f"{a.code} until {self._remedy(a.code)}"
+                                                          for a in left))
 
     @query
     def get_active_alarm(self, num_of_alarm: int) -> dict:
