@@ -178,3 +178,18 @@ def test_a_move_given_during_the_brake_starts_where_the_brake_ends(base, executo
     assert state(base) == VehicleState.READY
     x, y, theta = position(base)
     assert x == pytest.approx(3000.0, abs=5.0) and abs(y) < 5.0 and abs(theta) < 0.5
+
+
+def test_a_stop_during_a_paused_brake_ends_the_pause(base, executor):  # noqa: F811
+    """1.4.33 stop: 停止後は全ての動作指令を廃棄し，待機状態に移行します. A stop while the brake after a
+    contact was paused discarded the queue but kept the pause: the base stayed Paused, and the
+    next move waited for a resume."""
+    brush_at_full_speed(base, executor)
+    assert base.unlock().ok and base.pause().ok
+    steps(executor, 0.2)
+    assert base.stop().ok
+    settle(executor, base, 2.0)
+    assert state(base) == VehicleState.READY and abs(base.odometry.v) < 5e-3
+    motion = base.move_forward(100.0).values["motion_id"]
+    settle(executor, base, 3.0)
+    assert base.device.is_over(motion) and not base.device.was_discarded(motion)

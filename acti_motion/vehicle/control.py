@@ -284,10 +284,12 @@ class Control:
 
     def _stop(self, reason: str = STOPPED) -> None:
         """Decelerate at the maximum acceleration and discard everything, `reason` given to
-        the waits on what is discarded."""
+        the waits on what is discarded. A brake runs on (it stops at the maximum already);
+        what is queued goes, and so does a pause (a stop ends one: 待機状態に移行)."""
         cur = self.device.current
         if cur is not None and isinstance(cur.motion, BrakeMotion):
             self.device.edit(lambda device: device.discard_queue(reason))
+            self.device.resume(self._dt)
             return
         self.device.stop(self._stop_ramp(), reason)
 
