@@ -188,25 +188,31 @@ class Device:
         """A stop came after `arrival()` gave `mark`, or was decelerating then."""
         return self._stops != mark
 
-    def pause(self, ramp: float, idle: bool = True) -> bool:
+    def pause(self, ramp: float, idle: bool = True, after_stop: bool = False) -> bool:
         """Decelerate over `ramp` seconds and hold (also what is queued and not yet started);
         the queue stays. False when already paused or stopping (a stop clears a pause), and,
         unless `idle`, when nothing runs or is queued: checked here, under the lock a stop takes
-        (a stop or servo_off between the caller's check and this left an idle arm paused)."""
+        (a stop or servo_off between the caller's check and this left an idle arm paused).
+        `after_stop`: a pause given while a stop decelerates holds once the stop is over (the
+        stop's ramp runs on), instead of being refused."""
         with self.lock:
-            if self.paused or self._stop_at is not None or not (idle or self.busy):
+            stopping = self._stop_at is not None
+            if self.paused or (stopping and not after_stop) or not (idle or self.busy):
                 return False
             self.paused = True
-            self._set_rate(0.0, ramp)
+            if not stopping:
+                self._set_rate(0.0, ramp)
             return True
 
     def resume(self, ramp: float) -> bool:
-        """Undo a pause, accelerating over `ramp` seconds. False when not paused."""
+        """Undo a pause, accelerating over `ramp` seconds (one given during a stop only stops
+        holding: the stop's ramp runs on). False when not paused."""
         with self.lock:
-            if not self.paused or self._stop_at is not None:
+            if not self.paused:
                 return False
             self.paused = False
-            self._set_rate(1.0, ramp)
+            if self._stop_at is None:
+                self._set_rate(1.0, ramp)
             return True
 
     def stop(self, ramp: float, reason: str = STOPPED) -> None:
@@ -443,6 +449,8 @@ class Device:
         else:
             self.completed += 1
         self.current = None
+        if not self.queue:          # where it rests, as measured (a brake's end was a forecast)
+            self.queued_end = self.hold
         self.revision += 1
         self.changed.notify_all()
         self._announce_retired()

@@ -134,3 +134,62 @@ def test_switching_the_sensor_on_again_while_locked_lets_the_base_back_away(base
     assert base.unlock().ok
     steps(executor, 0.1)
     assert state(base) == VehicleState.READY and base.move_forward(-200.0).ok
+
+
+def brush_at_full_speed(base, executor) -> None:  # noqa: F811
+    """A contact at 800 mm/s (the bumper brushed past something light): Locked, braking."""
+    ready(base)
+    base.set_velocity((800.0, 45.0))
+    assert base.set_digital_sensor_lock(True).ok
+    base.move_forward(5000.0)
+    run_until(executor, lambda: base.odometry.v > 0.79, 5.0)
+    touching = iter([True])
+    executor.world.bumper_in_contact = lambda: next(touching, False)
+    executor.step()
+    assert state(base) == VehicleState.LOCKED
+
+
+def test_a_pause_during_the_brake_after_a_contact_brings_the_base_to_rest(base, executor):  # noqa: F811
+    """1.4.22 pause: 動作中の場合は，まず設定された最大加速度で停止し，完全停止後に一時停止状態.
+    A brush of the bumper at 800 mm/s, unlocked at once, then a pause: the pause froze the
+    brake's clock, so its wheels kept turning at the speed they had (272 mm/s for ever) while
+    the state said Paused."""
+    brush_at_full_speed(base, executor)
+    assert base.unlock().ok and base.pause().ok
+    steps(executor, 1.5)                                        # 0.8 s to rest at 1000 mm/s²
+    assert state(base) == VehicleState.PAUSED and abs(base.odometry.v) < 5e-3
+    x = position(base)[0]
+    steps(executor, 1.0)
+    assert position(base)[0] == pytest.approx(x, abs=1.0)
+    assert base.resume().ok
+    settle(executor, base, 2.0)
+    assert state(base) == VehicleState.READY and position(base)[0] == pytest.approx(x, abs=5.0)
+
+
+def test_a_move_given_during_the_brake_starts_where_the_brake_ends(base, executor):  # noqa: F811
+    """1.4.19 moveLinearAbs: 現在位置・姿勢から…直線的に移動. Accepted while the brake after a
+    contact ran (unlocked at once), it was planned from where the base was then, 320 mm short
+    of where the brake ended: the base could not follow and went Stuck."""
+    brush_at_full_speed(base, executor)
+    assert base.unlock().ok
+    motion = base.move_linear_abs((3000.0, 0.0, 0.0)).values["motion_id"]
+    settle(executor, base, 10.0)
+    assert not base.device.was_discarded(motion), base.device.discard_reason(motion)
+    assert state(base) == VehicleState.READY
+    x, y, theta = position(base)
+    assert x == pytest.approx(3000.0, abs=5.0) and abs(y) < 5.0 and abs(theta) < 0.5
+
+
+def test_a_stop_during_a_paused_brake_ends_the_pause(base, executor):  # noqa: F811
+    """1.4.33 stop: 停止後は全ての動作指令を廃棄し，待機状態に移行します. A stop while the brake after a
+    contact was paused discarded the queue but kept the pause: the base stayed Paused, and the
+    next move waited for a resume."""
+    brush_at_full_speed(base, executor)
+    assert base.unlock().ok and base.pause().ok
+    steps(executor, 0.2)
+    assert base.stop().ok
+    settle(executor, base, 2.0)
+    assert state(base) == VehicleState.READY and abs(base.odometry.v) < 5e-3
+    motion = base.move_forward(100.0).values["motion_id"]
+    settle(executor, base, 3.0)
+    assert base.device.is_over(motion) and not base.device.was_discarded(motion)

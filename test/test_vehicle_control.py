@@ -91,6 +91,40 @@ def test_moves_sent_during_the_stops_deceleration_are_discarded(base, executor, 
     assert not base.device.busy and state(base) == VehicleState.READY
 
 
+def test_a_pause_during_the_stops_deceleration_holds_once_the_base_is_at_rest(base, executor, trace):  # noqa: F811
+    """1.4.22 pause (常に真): 動作中の場合は…完全停止後に一時停止状態となります. Given while a stop
+    decelerated, the pause was true and lost: the base came to rest Ready and ran the next
+    move at once."""
+    ready(base)
+    base.set_velocity((800.0, 45.0))
+    base.move_forward(3000.0)
+    trace.until(lambda: base.odometry.v > 0.7, 5.0)
+    base.stop()
+    rest = base.device.queued_end
+    assert base.pause().ok and state(base) == VehicleState.BUSY
+    assert "discarded" in base.move_forward(100.0).comment      # the stop still discards it
+    trace.until_idle()
+    trace.check(rest=rest)
+    assert state(base) == VehicleState.PAUSED
+    r = base.move_forward(200.0)                                # kept for resume
+    assert r.ok and not r.comment
+    trace.step(1.0)
+    assert base.device.queue_length == 1 and state(base) == VehicleState.PAUSED
+    assert base.resume().ok
+    trace.until_idle(5.0)
+    assert base.device.completed == 1 and state(base) == VehicleState.READY
+
+
+def test_a_resume_during_the_stops_deceleration_undoes_a_pause_given_there(base, executor, trace):  # noqa: F811
+    ready(base)
+    base.move_forward(3000.0)
+    trace.until(lambda: base.odometry.v > 0.29, 5.0)
+    base.stop()
+    assert base.pause().ok and base.resume().ok
+    trace.until_idle()
+    assert state(base) == VehicleState.READY
+
+
 # --- planning never blocks the control plane ------------------------------------------------
 @pytest.fixture
 def planning_gate(monkeypatch):

@@ -163,6 +163,29 @@ def test_continuous_rel_new_target_replaces_the_old_with_continuous_velocity(
     assert base.device.completed == 1
 
 
+def turned_until_idle(executor, base):  # noqa: F811
+    """Degrees the base turned (signed, summed step by step) until it has nothing left to do."""
+    total, last = 0.0, base.odometry.pose.theta
+    while base.device.busy:
+        executor.step()
+        total += math.remainder(base.odometry.pose.theta - last, 2 * math.pi)
+        last = base.odometry.pose.theta
+    return math.degrees(total)
+
+
+@pytest.mark.parametrize("theta", [270.0, 360.0, -200.0])
+def test_continuous_rel_turns_by_its_theta_also_when_it_takes_over(base, executor, theta):  # noqa: F811
+    """1.4.15 pos.theta: the target heading relative to the base, turned as given (270°
+    counter-clockwise), as from rest and as move_linear_rel. Taking over a moving base, the
+    final turn was wrapped: 270° turned 90° clockwise, 360° not at all."""
+    ready(base)
+    assert base.move_continuous_rel((0.0, 0.0, theta)).ok
+    assert turned_until_idle(executor, base) == pytest.approx(theta, abs=0.5)
+    base.move_forward(3000.0)
+    steps(executor, 1.5)
+    assert base.move_continuous_rel((1500.0, 200.0, theta)).ok
+    assert turned_until_idle(executor, base) == pytest.approx(theta, abs=0.5)
+
 def test_continuous_rel_keeps_only_the_last_target(base, executor):  # noqa: F811
     ready(base)
     base.move_continuous_rel((1000.0, 0.0, 0.0))

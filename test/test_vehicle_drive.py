@@ -107,6 +107,23 @@ def test_joystick_drives_within_the_settings_and_off_brakes_to_ready(base, execu
     assert not base.joy_input([0.0, 1.0], [])
 
 
+@pytest.mark.parametrize("stick", [1.0, -0.5])
+def test_a_velocity_setting_changed_while_the_joystick_drives_limits_it_at_once(base, executor, stick):  # noqa: F811
+    """1.4.27: the joystick's target speed is limited by setVelocity; 1.4.32: while moving, the
+    speed changes continuously to the new setting. The drive went on at the old setting's
+    speed until the next Joy sample (or its deadman, with a joystick that sends only changes)."""
+    ready(base)
+    assert base.set_jog_timeout(5000).ok and base.set_joystick(True).ok
+    assert base.joy_input([0.0, stick], [])
+    steps(executor, 1.5)
+    assert base.odometry.v == pytest.approx(0.3 * stick, abs=0.01)
+    assert base.set_velocity((100.0, 45.0)).ok
+    took = run_until(executor, lambda: abs(base.odometry.v - 0.1 * stick) < 0.01, 1.0)
+    assert took < abs(0.2 * stick) / 0.5 + 0.2                # at the acceleration setting
+    steps(executor, 1.0)
+    assert base.odometry.v == pytest.approx(0.1 * stick, abs=0.01)
+    assert base.device.current.label == "joystick"
+
 def test_joystick_off_brakes_its_drive_with_a_move_queued_behind(base, executor):  # noqa: F811
     """常に真を返します; 減速停止後に Ready: it answered false ("busy with other moves") and the
     drive went on to its deadman."""

@@ -89,6 +89,19 @@ def test_power_on_fails_on_an_empty_battery(executor):  # noqa: F811
     assert not r.ok and "cut-off" in r.comment and state(base) == VehicleState.UNPOWERED
 
 
+def test_power_on_while_on_is_true_below_the_cut_off(base, executor):  # noqa: F811
+    """1.4.30 setPower: 偽 = 主回路電源投入に失敗. With the power on and the battery under its
+    cut-off (Alarm-201), set_power(true) answered false, "power stays off", and the power
+    stayed on: nothing failed to switch on."""
+    ready(base)
+    exhaust_battery(base, executor)
+    r = base.set_power(True)
+    assert r.ok and base.power and state_msg(base) == "Alarm-201"
+    assert base.set_power(False).ok
+    r = base.set_power(True)
+    assert not r.ok and "power stays off" in r.comment and not base.power
+
+
 # --- alarms --------------------------------------------------------------------------------
 def test_get_active_alarm_fills_at_most_what_is_asked_and_counts_all(base):
     ready(base)

@@ -123,12 +123,18 @@ def test_clear_alarm_clears_every_alarm_and_a_present_cause_raises_its_own_again
     base.locked = True                                         # contact 301, Locked
     base.alarms.raise_(AlarmCode.CONTACT, "contact sensor", Kind.CONTACT)
     assert {a[0] for a in base.get_active_alarm(9).values["active_alarms"]} == {104, 110, 301}
-    assert base.clear_alarm().ok
-    # the battery's cause is there, and so is the lock (only unlock leaves it): 301 says why
+    r = base.clear_alarm()
+    assert r.ok
+    # the battery's cause is there, and so is the lock (only unlock leaves it): 301 says why,
+    # and so does the reply (it was true and silent: 全てのアラームを解除 read as done)
     assert [a[0] for a in base.get_active_alarm(9).values["active_alarms"]] == [301, 110]
+    assert r.comment == ("still active: 301 until unlock; 110 until the battery is back at "
+                         "47 V and clear_alarm is called"), r.comment
     assert state(base) == VehicleState.LOCKED
     base.battery.charge = 1.0
-    assert base.unlock().ok and base.clear_alarm().ok
+    assert base.unlock().ok
+    r = base.clear_alarm()
+    assert r.ok and not r.comment
     assert base.get_active_alarm(9).values["num_of_active_alarm"] == 0
 
 

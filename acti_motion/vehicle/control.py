@@ -69,9 +69,10 @@ class Control:
 
     @command
     def set_power(self, on_off: bool) -> None:
-        """Main power; switching it off stops the base and drops the servo. On is refused while
-        the battery is below its cut-off (with the hysteresis band)."""
-        if on_off and self._battery_empty.update(self.battery.voltage):
+        """Main power; switching it off stops the base and drops the servo. Switching on is
+        refused while the battery is below its cut-off (with the hysteresis band); power that
+        is on already stays on, true (偽 = 主回路電源投入に失敗: nothing failed)."""
+        if on_off and not self.power and self._battery_empty.update(self.battery.voltage):
             raise VehicleRefused(AlarmCode.WRONG_STATE,
                                  f"the battery is at {self.battery.voltage:.1f} V, below the cut-off "
                                  f"{self.config.battery_cutoff_voltage:g} V + "
@@ -99,11 +100,12 @@ class Control:
         self.servo = bool(on_off)
 
     def _remedy(self, code: int) -> str:
-        """What ends a fault: unlock for a contact, a charged battery for the cut-off."""
+        """What ends an alarm: unlock for a contact, a charged battery for the battery's."""
         if code == AlarmCode.CONTACT:
             return "unlock"
-        if code == AlarmCode.BATTERY_EMPTY:
-            level = self._battery_empty
+        level = {AlarmCode.BATTERY_EMPTY: self._battery_empty,
+                 AlarmCode.BATTERY_LOW: self._battery_low}.get(code)
+        if level is not None:
             return f"the battery is back at {level.level + level.band:g} V and clear_alarm is called"
         return "clear_alarm"
 
@@ -116,14 +118,20 @@ class Control:
 
     # --- alarms -----------------------------------------------------------------------------
     @command
-    def clear_alarm(self) -> None:
+    def clear_alarm(self) -> Reply | None:
         """Clear every alarm (1.4.1: 発生した全てのアラームを解除). One whose cause is still there
         is raised again at once: a battery still within its hysteresis band of the level. Stuck
         ends; Locked is a state that only unlock leaves, and its contact fault stays with it (a
-        client would see a locked base with no alarm to say why)."""
+        client would see a locked base with no alarm to say why). The reply (always true) says
+        which alarms are still active and what ends each."""
         self.alarms.clear(*(k for k in Kind if not (k is Kind.CONTACT and self.locked)))
         self.stuck = False
         self._check_battery(self.battery.voltage)
+        left = self.alarms.active()
+        if not left:
+            return None
+        return Reply(comment="still active: " + "; ".join(f"{a.code} until {self._remedy(a.code)}"
+                                                          for a in left))
 
     @query
     def get_active_alarm(self, num_of_alarm: int) -> dict:
@@ -215,12 +223,13 @@ class Control:
     @command
     def pause(self) -> Reply | None:
         """Decelerate at the maximum acceleration and hold; the queue stays, new motions queue.
-        Ignored (still true, with a comment) where no motion can run: Unpowered, Powered,
+        Given while a stop decelerates, it holds once the base is at rest (完全停止後に一時停止
+        状態). Ignored (still true, with a comment) where no motion can run: Unpowered, Powered,
         Alarm, Locked; switching the servo off ends a pause."""
         s = self.state()
         if s not in SERVO_ON:
             return Reply(comment=f"ignored: the base is {STATE_STRINGS[s]}, there is nothing to pause")
-        self.device.pause(self._stop_ramp())
+        self.device.pause(self._stop_ramp(), after_stop=True)
         return None
 
     @command

@@ -85,6 +85,7 @@ class VehicleCore(Control, Planning, Sensing):
             raise ValueError(f"vehicle configuration: {r.comment}") from None
         self.jog_timeout = c.jog_timeout
         self.joystick = False
+        self._stick = (0.0, 0.0)             # the last Joy sample's deflections that drove the base
         self._dt = executor.dt
         self._warm_up()
         executor.before_step(self._sense)

@@ -299,7 +299,9 @@ def transition_to(start: Pose2D, v0: float, w0: float, goal: Pose2D,
                   limits: tuple[float, float, float, float]) -> Path:
     """moveContinuousRel's path from the reference state (start, v0, w0) to `goal`, speed
     continuous: from rest the straight move; moving forward toward a goal ahead, a smooth curve
-    onto it (TOPP-RA from v0) and a turn to its heading; otherwise brake, then the straight move."""
+    onto it (TOPP-RA from v0) and a turn to its heading; otherwise brake, then the straight move.
+    Every way the heading change is the one given (goal.theta is unwrapped, as the curve's
+    heading is): a 270° target turns 270°, as from rest, not 90° the other way."""
     if abs(v0) < 1e-3 and abs(w0) < 1e-3:
         return straight_to(start, goal, limits, False)
     bearing = wrap_angle(math.atan2(goal.y - start.y, goal.x - start.x) - start.theta)
@@ -307,7 +309,7 @@ def transition_to(start: Pose2D, v0: float, w0: float, goal: Pose2D,
         plan = plan_curve(start, [(goal.x, goal.y)], limits, v0, w0)
         if plan is not None:
             end = plan.path.pose(plan.path.duration)
-            final = turn(end, wrap_angle(goal.theta - end.theta), limits)
+            final = turn(end, goal.theta - end.theta, limits)
             return Chain([plan.path, final], start)
     brake = velocity_path(start, v0, w0, (0.0, 0.0), 0.0, (limits[2], limits[3]))
     rest = brake.pose(brake.duration)

@@ -551,7 +551,10 @@ class TrackedBaseMotion:
 
 class BrakeMotion:
     """Stop the wheels from their measured speeds at the given decelerations, without a reference
-    pose (after a contact or a blockage); the set-point is wherever odometry says the base is."""
+    pose (after a contact or a blockage); the set-point is wherever odometry says the base is.
+
+    The brake runs on the world's clock, not the device's: a pause slows the device's clock to
+    a halt, which froze the brake with its wheels still turning (pause: 最大加速度で停止し)."""
 
     SETTLE = 0.1
 
@@ -562,15 +565,29 @@ class BrakeMotion:
         self.ramp = max(abs(self.v0) / decel[0], abs(self.w0) / decel[1], 1e-3)
         self.duration = self.ramp + self.SETTLE
         self.error = (0.0, 0.0)
+        self._began: float | None = None     # world time at which the brake's clock was 0
+        self._now: float | None = None       # world time of the last step applied
 
     def at(self, t: float) -> Pose2D:
-        return self.odometry.pose
+        """Where the base comes to rest: the measured pose moved on by what is left of the brake
+        (an arc: both speeds fall together). A move queued behind the brake starts there; from
+        the pose at its planning it started short by the braking distance and went Stuck."""
+        k = self._left(self._now)
+        left = self.ramp * k * k / 2
+        return ConstantTwist(self.odometry.pose, (self.v0 * left, self.w0 * left), 1.0).pose(1.0)
+
+    def _left(self, now: float | None) -> float:
+        """The fraction of the start speeds commanded at world time `now` (None: not begun)."""
+        return 1.0 if now is None else max(0.0, 1.0 - (now - self._began) / self.ramp)
 
     def move_frame(self, frame: Pose2D) -> None:
         """Nothing to move: the set-point is the odometry itself."""
 
     def apply(self, world: World, t: float, rate: float) -> None:
-        k = max(0.0, 1.0 - t / self.ramp)
+        if self._began is None:
+            self._began = world.time - t
+        self._now = world.time
+        k = self._left(self._now)
         v, w = self.v0 * k, self.w0 * k
         r, b = self.odometry.r, self.odometry.b
         world.set_wheel_velocities((v - w * b / 2) / r, (v + w * b / 2) / r)

@@ -45,10 +45,12 @@ class Planning:
     @planned
     def set_velocity(self, vel: Any) -> None:
         """Within [velocity_min, limit]. A moving base changes speed smoothly (at the
-        acceleration setting) to match; queued moves take it too. Jogs keep their velocities."""
+        acceleration setting) to match; queued moves take it too. Jogs keep their velocities (the
+        command's own); a joystick drive scales to it (full stick = the setting)."""
         value = bounded_pair(vel, *self.velocity_bounds, "vel", ("mm/s", "degree/s"))
         self._retime(value, self.acceleration)
         self.velocity = value
+        self._rescale_joystick()
 
     @planned
     def set_acceleration(self, accel: Any) -> None:
@@ -286,14 +288,32 @@ class Planning:
             def axis(i: int) -> float:
                 value = axes[i] if 0 <= i < len(axes) else 0.0
                 return min(1.0, max(-1.0, value)) if math.isfinite(value) else 0.0
-            vt, vr = self.velocity
-            target = si_pair((axis(c.joy_axis_linear) * vt, axis(c.joy_axis_angular) * vr))
+            stick = (axis(c.joy_axis_linear), axis(c.joy_axis_angular))
             try:
-                self._drive(target, self.jog_timeout / 1000.0, si_pair(self.acceleration),
-                            "joystick", take_over=False)
+                self._drive(self._stick_target(stick), self.jog_timeout / 1000.0,
+                            si_pair(self.acceleration), "joystick", take_over=False)
             except Refused:
                 return False
+            self._stick = stick
             return True
+
+    def _stick_target(self, stick: tuple[float, float]) -> tuple[float, float]:
+        """The joystick's (v, w) in SI for stick deflections in −1 … 1: full stick = the setting."""
+        return si_pair((stick[0] * self.velocity[0], stick[1] * self.velocity[1]))
+
+    def _rescale_joystick(self) -> None:
+        """A joystick drive takes a new velocity setting at once, not at the next Joy sample
+        (1.4.27: its speed is limited by setVelocity; 1.4.32: a moving base changes speed to
+        match), keeping its deadman's deadline."""
+        cur, left = self.device.current, self._drive_deadline - time.monotonic()
+        if cur is None or cur.label != "joystick" or self._deadman_fired == cur.id \
+                or not 0.0 < left < math.inf:
+            return
+        try:
+            self._drive(self._stick_target(self._stick), left, si_pair(self.acceleration),
+                        "joystick", take_over=False)
+        except Refused:
+            pass    # held by a pause, or moves queued behind it: its next sample or its deadman
 
     # --- helpers ----------------------------------------------------------------------------
     @contextmanager
