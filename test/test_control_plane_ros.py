@@ -7,6 +7,9 @@ from __future__ import annotations
 
 import math
 import os
+import re
+import subprocess
+import sys
 import time
 from dataclasses import dataclass
 from typing import Any, Callable
@@ -15,6 +18,7 @@ import pytest
 from acti_msgs import srv
 from acti_msgs.action import Move, VehicleWaitMotion, WaitMotion
 from action_msgs.msg import GoalStatus
+from rosgraph_msgs.msg import Clock
 
 from ros_harness import Actions, node_fixture, wait_until
 
@@ -210,3 +214,45 @@ def test_wait_motion_refuses_a_timeout_that_is_not_finite_and_positive(ros, devi
     assert status == GoalStatus.STATUS_ABORTED and device.refused(result)
     message = result.return_id.comment if device.name == "arm" else result.message
     assert "finite number of seconds" in message
+
+
+# one `ros2 service call`: a DDS participant that starts, asks once and ends
+ONE_CALL = """import sys, rclpy
+from acti_msgs.srv import GetState
+rclpy.init()
+node = rclpy.create_node("one_call")
+client = node.create_client(GetState, sys.argv[1])
+if client.wait_for_service(timeout_sec=20.0):
+    rclpy.spin_until_future_complete(node, client.call_async(GetState.Request()), timeout_sec=10.0)
+"""
+HELD_UP_MS = 200        # Fast DDS's sleep at a shared-memory port: 333 ms
+
+
+def test_participants_that_come_and_go_never_hold_up_the_control_loop(ros, job):
+    """Fast DDS sleeps a third of a second inside a send when it meets the shared-memory port of
+    a participant that is starting or ending, and rclpy sent with the GIL held: about one in
+    five one-shot clients froze the whole job, the control loop with it (it publishes /clock
+    while anybody listens). Sends now leave from the outbox without the GIL, and the loop
+    reports any fall behind its schedule; here none is one of Fast DDS's sleeps, and the job
+    answers between the clients."""
+    clock = ros.node.create_subscription(Clock, "/clock", lambda _msg: None, 10)
+    seen = len(job.log())
+    clients, started = [], 0
+    try:
+        deadline = time.monotonic() + 15.0
+        while time.monotonic() < deadline:
+            clients = [c for c in clients if c.poll() is None]
+            while len(clients) < 2:
+                clients.append(subprocess.Popen([sys.executable, "-c", ONE_CALL, ARM + "get_state"],
+                                                stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT))
+                started += 1
+            assert ros.call(srv.GetState, ARM + "get_state").return_id.id == 0
+            ros.spin_until(lambda: False, 0.05)
+        for c in clients:
+            c.wait(timeout=60.0)
+    finally:
+        for c in clients:
+            c.kill()
+        ros.node.destroy_subscription(clock)
+    falls = [int(ms) for ms in re.findall(r"fell (\d+) ms behind", job.log()[seen:])]
+    assert started >= 6 and all(ms < HELD_UP_MS for ms in falls), (started, falls)
