@@ -174,8 +174,10 @@ async def wait_for_motion(goal_handle: Any, device: Device, watch: Watch,
             return WaitOutcome(target, "abort", message=f"timed out after {goal.timeout:g} s")
         return None
     # the deadline pokes the watch itself: checked on the feedback tick alone, a timeout was
-    # answered up to a feedback period late (0.01 s: 0.106 s)
-    alarm = threading.Timer(goal.timeout, watch.poke) if goal.timeout > 0 else None
+    # answered up to a feedback period late (0.01 s: 0.106 s). A timer cannot wait longer than
+    # TIMEOUT_MAX (~292 years; beyond, it dies of OverflowError): the tick checks such a deadline.
+    timed = 0 < goal.timeout <= threading.TIMEOUT_MAX
+    alarm = threading.Timer(goal.timeout, watch.poke) if timed else None
     if alarm is not None:
         alarm.daemon = True
         alarm.start()
