@@ -117,10 +117,13 @@ class MotionActions:
         if why is not None:
             result.return_id.comment = f"discarded: {why}"
         self._where(result)
+        # a move that did not run to its end is not a success, whatever discarded it
         if canceled:
             goal_handle.canceled()
-        else:
+        elif result.completed:
             goal_handle.succeed()
+        else:
+            goal_handle.abort()
         return result
 
     def _where(self, result: Move.Result) -> None:
