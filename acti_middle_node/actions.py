@@ -54,6 +54,7 @@ class MotionActions:
     def __init__(self, plane: Plane, core: ArmCore, config: ActionConfig) -> None:
         self.core, self.config = core, config
         self.watch = device_watch(plane, core.device, 1.0 / config.feedback_rate_hz)
+        plane.goal_ends.append(self.watch)
         slots = GoalSlots(plane.owner, config.max_action_goals, "max_action_goals")
         cancel = accept_cancel(self.watch)
         self.servers = [
@@ -97,13 +98,13 @@ class MotionActions:
         device = self.core.device
         canceled = False
 
-        def over() -> bool | None:
-            """True once the move retired; a cancel stops the arm (and is then waited out)."""
+        def over() -> str | None:
+            """"" once the move retired; a cancel stops the arm (and is then waited out)."""
             nonlocal canceled
             if goal_handle.is_cancel_requested and not canceled:
                 self.core.stop()
                 canceled = True
-            return True if device.is_over(motion_id) else None
+            return "" if device.is_over(motion_id) else None
 
         def feedback() -> None:
             """This goal's move: its progress once it runs (0 while queued)."""
@@ -111,10 +112,12 @@ class MotionActions:
             goal_handle.publish_feedback(Move.Feedback(
                 motion_id=motion_id, progress=progress if current == motion_id else 0.0,
                 queue_length=queued))
-        await self.watch.until(over, feedback)
-        why = device.discard_reason(motion_id)
+        shutdown = await self.watch.until(over, feedback, closed=lambda why: why)
+        why = shutdown or device.discard_reason(motion_id)
         result.completed = why is None
-        if why is not None:
+        if shutdown:
+            result.return_id = return_id(Reply(ReturnCode.NG, shutdown))
+        elif why is not None:
             result.return_id.comment = f"discarded: {why}"
         self._where(result)
         # a move that did not run to its end is not a success, whatever discarded it
