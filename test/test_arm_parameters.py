@@ -77,6 +77,10 @@ def test_every_parameter_has_a_description_and_says_whether_it_can_be_set(ros, a
         assert d.read_only == (d.name not in SETTABLE), d.name
     assert ranges["accel_time_joint"].floating_point_range[0].to_value == 10.0
     assert ranges["initial_speed_ratio"].integer_range[0].to_value == 100
+    # every number has its range (camera_rate_hz, camera_width … had none to describe)
+    numbers = (ParameterType.PARAMETER_INTEGER, ParameterType.PARAMETER_DOUBLE)
+    assert [d.name for d in ranges.values() if d.type in numbers
+            and not (d.floating_point_range or d.integer_range)] == []
 
 
 def test_an_integer_given_at_start_up_for_a_double_is_that_double(ros, arm_node):
