@@ -143,6 +143,18 @@ def test_goals_held_at_a_signal_end_aborted_and_their_clients_are_told(ros, tmp_
     assert "Traceback" not in node.log(), node.log()
 
 
+@pytest.mark.parametrize("module", ["acti_bringup", "vehicle_node"])
+def test_help_prints_the_usage_and_starts_nothing(tmp_path, module):
+    """`python -m acti_bringup --help` started a robot (and its live view) without a word."""
+    node = NodeProcess(module, str(tmp_path / "node.log"), args=("--help",))
+    try:
+        assert node.proc.wait(timeout=30.0) == 0, node.log()
+    finally:
+        node.stop()
+    assert f"python -m {module}" in node.log() and "--ros-args" in node.log()
+    assert "services under" not in node.log(), node.log()
+
+
 def test_nodes_of_one_name_are_one_line_and_exit_status_2(tmp_path):
     """`-r __node:=…` renames every node of the job: their services clashed with a traceback."""
     node = NodeProcess("acti_bringup", str(tmp_path / "node.log"), "view_enabled:=false",
