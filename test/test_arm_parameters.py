@@ -165,6 +165,20 @@ def test_vehicle_parameters_are_described_and_read_only(ros, vehicle_node):
     assert not r.successful and "read-only" in r.reason
 
 
+def test_the_shipped_parameter_file_lists_every_parameter(ros, arm_node, vehicle_node):
+    """config/acti_ros2.yaml lacked clock_rate_hz, wait_feedback_rate_hz and max_wait_goals:
+    the README sends users to it for every parameter and its units."""
+    import os
+
+    import yaml
+    with open(os.path.join(os.path.dirname(__file__), "..", "config", "acti_ros2.yaml")) as f:
+        shipped = {k: set(v["ros__parameters"]) for k, v in yaml.safe_load(f).items()}
+    arm, base = shipped["/**/acti_middle_node"], shipped["/**/vehicle_node"]
+    assert set(described(ros, ARM)) - arm == set()
+    # the simulation's parameters are the arm's in the main job (it hosts the simulation)
+    assert set(described(ros, BASE)) - base - arm == set()
+
+
 def test_a_change_through_a_service_shows_in_the_parameter(ros, arm_node):
     r = ros.call(srv.SetMaxSpeedCartesian, ARM + "set_max_speed_cartesian",
                  speed=CartesianSpeed(translation=321.0, rotation=45.0))
