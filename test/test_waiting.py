@@ -143,3 +143,16 @@ def test_a_timeout_longer_than_a_timer_can_wait_is_waited_without_error(wait, mo
     out = wait(d, Goal(1, timeout=1e300), period=10.0)
     assert out.end == "succeed" and out.completed
     assert [e.exc_type for e in errors] == []
+
+
+def test_closing_the_watch_ends_a_pending_wait_aborted_with_why(ros):
+    """What the process does to the goals it holds when it stops (`end_goals`)."""
+    d = device_with(1)
+    watch = device_watch(ros.node, d, 10.0)
+    task = ros.executor.create_task(wait_for_motion(Handle(Goal(1)), d, watch,
+                                                    lambda *status: None))
+    threading.Timer(0.05, watch.close, ["the node shuts down"]).start()
+    assert ros.wait(task, 5.0), "the wait never ended"
+    out = task.result()
+    assert out.aborted and not out.completed and out.message == "the node shuts down"
+    assert watch.idle
