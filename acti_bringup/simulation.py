@@ -24,6 +24,7 @@ from acti_bringup.priority import (FIFO_RANGE, NICE_RANGE, check_fifo_priority, 
                                    set_fifo, set_niceness)
 from acti_bringup.visual.robot_graph import RobotGraph
 from acti_bringup.serving.spinning import Planes, build_or_exit, init, wait_for_signal
+from acti_bringup.serving.waiting import end_goals
 from acti_motion.config_fields import ranged
 from acti_motion.executor import MotionExecutor
 from acti_sim.world import World
@@ -129,6 +130,7 @@ class Simulation:
         try:
             wait_for_signal(planes.serving)
         finally:
+            end_goals(helpers)
             self.executor.shutdown()
             planes.stop()
             for n in (*helpers, *nodes):

@@ -56,6 +56,7 @@ class MotionActions:
         self.core, self.config = core, config
         self.watch = device_watch(plane, core.device, 1.0 / config.feedback_rate_hz)
         self._planner = ThreadPoolExecutor(1, thread_name_prefix="acti-move-goals")
+        plane.goal_ends.append(self.watch)
         slots = GoalSlots(plane.owner, config.max_action_goals, "max_action_goals")
         cancel = accept_cancel(self.watch)
         self.servers = [
@@ -99,13 +100,13 @@ class MotionActions:
         device = self.core.device
         canceled = False
 
-        def over() -> bool | None:
-            """True once the move retired; a cancel stops the arm (and is then waited out)."""
+        def over() -> str | None:
+            """"" once the move retired; a cancel stops the arm (and is then waited out)."""
             nonlocal canceled
             if goal_handle.is_cancel_requested and not canceled:
                 self.core.stop()
                 canceled = True
-            return True if device.is_over(motion_id) else None
+            return "" if device.is_over(motion_id) else None
 
         def feedback() -> None:
             """This goal's move: its progress once it runs (0 while queued)."""
@@ -113,16 +114,21 @@ class MotionActions:
             goal_handle.publish_feedback(Move.Feedback(
                 motion_id=motion_id, progress=progress if current == motion_id else 0.0,
                 queue_length=queued))
-        await self.watch.until(over, feedback)
-        why = device.discard_reason(motion_id)
+        shutdown = await self.watch.until(over, feedback, closed=lambda why: why)
+        why = shutdown or device.discard_reason(motion_id)
         result.completed = why is None
-        if why is not None:
+        if shutdown:
+            result.return_id = return_id(Reply(ReturnCode.NG, shutdown))
+        elif why is not None:
             result.return_id.comment = f"discarded: {why}"
         self._where(result)
+        # a move that did not run to its end is not a success, whatever discarded it
         if canceled:
             goal_handle.canceled()
-        else:
+        elif result.completed:
             goal_handle.succeed()
+        else:
+            goal_handle.abort()
         return result
 
     async def _off_plane(self, move: Callable[[], Reply]) -> Reply:

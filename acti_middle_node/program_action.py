@@ -35,12 +35,24 @@ class ProgramAction:
         self.io = RobotIO()
         self._busy = False
         self._current: ProgramRun | None = None
+        self._closed = ""
         self._lock = threading.Lock()
         self.server = action_server(plane, RunProgram, plane.name("run_program"), self._execute,
                                    goal_callback=self._admit, cancel_callback=self._cancel)
         # the node stops: so does the run. A method returning None: rclpy calls what the
         # callback returns, so a lambda returning a CancelResponse crashed the shutdown
         plane.context.on_shutdown(self._cancel_run)
+        plane.goal_ends.append(self)
+
+    def close(self, why: str) -> None:
+        """The process stops: the run is canceled, and its goal ends (aborted, saying `why`)
+        once the arm is at rest."""
+        self._closed = why
+        self._cancel_run()
+
+    @property
+    def idle(self) -> bool:
+        return not self._busy
 
     def _admit(self, _goal: Any) -> GoalResponse:
         with self._lock:
@@ -93,7 +105,11 @@ class ProgramAction:
             exception_kind=error.kind.value if error else "",
             exception_offset=_offset(error), stack=r.stack, output=r.output,
             console=r.console, instructions=r.instructions, duration=r.duration)
-        end = {Status.FINISHED: goal_handle.succeed, Status.CANCELED: goal_handle.canceled}
+        end = {Status.FINISHED: goal_handle.succeed}
+        if goal_handle.is_cancel_requested:     # else canceled by the process's stop (`close`)
+            end[Status.CANCELED] = goal_handle.canceled
+        elif self._closed:
+            result.exception = f"{r.report} ({self._closed})"
         self._quietly_at_shutdown(end.get(r.status, goal_handle.abort))
         return result
 

@@ -77,6 +77,10 @@ def test_every_parameter_has_a_description_and_says_whether_it_can_be_set(ros, a
         assert d.read_only == (d.name not in SETTABLE), d.name
     assert ranges["accel_time_joint"].floating_point_range[0].to_value == 10.0
     assert ranges["initial_speed_ratio"].integer_range[0].to_value == 100
+    # every number has its range (camera_rate_hz, camera_width … had none to describe)
+    numbers = (ParameterType.PARAMETER_INTEGER, ParameterType.PARAMETER_DOUBLE)
+    assert [d.name for d in ranges.values() if d.type in numbers
+            and not (d.floating_point_range or d.integer_range)] == []
 
 
 def test_an_integer_given_at_start_up_for_a_double_is_that_double(ros, arm_node):
@@ -159,6 +163,20 @@ def test_vehicle_parameters_are_described_and_read_only(ros, vehicle_node):
         name="velocity_limit_translation",
         value=value(ParameterType.PARAMETER_DOUBLE, 500.0))]).results[0]
     assert not r.successful and "read-only" in r.reason
+
+
+def test_the_shipped_parameter_file_lists_every_parameter(ros, arm_node, vehicle_node):
+    """config/acti_ros2.yaml lacked clock_rate_hz, wait_feedback_rate_hz and max_wait_goals:
+    the README sends users to it for every parameter and its units."""
+    import os
+
+    import yaml
+    with open(os.path.join(os.path.dirname(__file__), "..", "config", "acti_ros2.yaml")) as f:
+        shipped = {k: set(v["ros__parameters"]) for k, v in yaml.safe_load(f).items()}
+    arm, base = shipped["/**/acti_middle_node"], shipped["/**/vehicle_node"]
+    assert set(described(ros, ARM)) - arm == set()
+    # the simulation's parameters are the arm's in the main job (it hosts the simulation)
+    assert set(described(ros, BASE)) - base - arm == set()
 
 
 def test_a_change_through_a_service_shows_in_the_parameter(ros, arm_node):

@@ -171,6 +171,19 @@ def test_canceling_a_move_stops_the_arm(ros, arm_node, move):
     assert state & 0x02 == 0 and state & 0x01
 
 
+def test_a_move_that_a_stop_discards_ends_its_goal_aborted(ros, arm_node, move):
+    """A goal whose move did not run to its end does not succeed: a client that reads only the
+    goal status (a behaviour tree, `ros2 action send_goal`) saw SUCCEEDED for a stopped move."""
+    ready(ros)
+    call(ros, "set_speed_joint", srv.SetSpeedJoint, spd_ratio=10)
+    handle = move.send(kind=Move.Goal.PTP_JOINT_REL, joint_points=[-60.0] + [0.0] * 6)
+    assert wait_until(lambda: call(ros, "get_state", srv.GetState).state & 0x02, 10.0)
+    assert call(ros, "stop", srv.Stop).return_id.id == 0
+    status, result = move.result(handle)
+    assert status == GoalStatus.STATUS_ABORTED and not result.completed
+    assert result.return_id.comment == "discarded: stop"
+
+
 def test_state_topic(ros, arm_node):
     got = []
     sub = ros.node.create_subscription(ArmState, ARM + "state", got.append, 10)

@@ -87,6 +87,56 @@ def test_the_nodes_end_cleanly_on_a_signal(ros, tmp_path, module, up, signum):
     assert "Traceback" not in node.log(), node.log()
 
 
+def test_goals_held_at_a_signal_end_aborted_and_their_clients_are_told(ros, tmp_path):
+    """A client waiting for a goal's result when the job was stopped waited for ever: the
+    goals died with the process unanswered (rclcpp ends a goal handle destroyed without an
+    end; rclpy does not). Now every held goal ends aborted, saying why, before the job exits
+    (a program's once the arm it stopped is at rest)."""
+    from acti_msgs.action import Move, RunProgram, VehicleWaitMotion, WaitMotion
+    from acti_msgs.srv import (ServoON, SetSpeedJoint, VehicleMoveForward, VehicleSetPower,
+                               VehicleSetServo)
+    from action_msgs.msg import GoalStatus
+    from ros_harness import Actions
+    node = NodeProcess("acti_bringup", str(tmp_path / "node.log"), "view_enabled:=false")
+    try:
+        assert wait_until(lambda: "services under" in node.log(), 60.0), node.log()
+        ros.call(ServoON, "/acti_middle_node/servo_on")
+        ros.call(SetSpeedJoint, "/acti_middle_node/set_speed_joint", spd_ratio=5)
+        move = Actions(ros, Move, "/acti_middle_node/move")
+        held = [move.send(kind=Move.Goal.PTP_JOINT_REL, joint_points=[90.0] + [0.0] * 6),
+                Actions(ros, WaitMotion, "/acti_middle_node/wait_motion").send(motion_id=0)]
+        ros.call(VehicleSetPower, "/vehicle_node/set_power", on_off=True)
+        ros.call(VehicleSetServo, "/vehicle_node/set_servo", on_off=True)
+        assert ros.call(VehicleMoveForward, "/vehicle_node/move_forward", x=5000.0).success
+        held.append(Actions(ros, VehicleWaitMotion, "/vehicle_node/wait_motion").send())
+        held.append(Actions(ros, RunProgram, "/acti_middle_node/run_program").send(
+            text="Ar[R8 0 30 0 -60 0 60 0] ADRIVE DROP -1 $WAIT"))
+        results = [h.get_result_async() for h in held]
+        node.proc.send_signal(signal.SIGINT)
+        assert node.proc.wait(timeout=15.0) == 0, node.log()
+        assert ros.spin_until(lambda: all(r.done() for r in results), 5.0), node.log()
+    finally:
+        node.stop()
+    arm, (base, program) = [r.result() for r in results[:2]], [r.result() for r in results[2:]]
+    assert all(r.status == GoalStatus.STATUS_ABORTED for r in (*arm, base, program))
+    assert all("shuts down" in r.result.return_id.comment for r in arm)
+    assert "shuts down" in base.result.message and not base.result.completed
+    assert "shuts down" in program.result.exception
+    assert "Traceback" not in node.log(), node.log()
+
+
+@pytest.mark.parametrize("module", ["acti_bringup", "vehicle_node"])
+def test_help_prints_the_usage_and_starts_nothing(tmp_path, module):
+    """`python -m acti_bringup --help` started a robot (and its live view) without a word."""
+    node = NodeProcess(module, str(tmp_path / "node.log"), args=("--help",))
+    try:
+        assert node.proc.wait(timeout=30.0) == 0, node.log()
+    finally:
+        node.stop()
+    assert f"python -m {module}" in node.log() and "--ros-args" in node.log()
+    assert "services under" not in node.log(), node.log()
+
+
 def test_nodes_of_one_name_are_one_line_and_exit_status_2(tmp_path):
     """`-r __node:=…` renames every node of the job: their services clashed with a traceback."""
     node = NodeProcess("acti_bringup", str(tmp_path / "node.log"), "view_enabled:=false",

@@ -131,3 +131,28 @@ def test_a_timeout_is_answered_at_its_deadline_not_at_the_next_tick(wait):
     d = device_with(1)
     out = wait(d, Goal(1, timeout=0.05), period=30.0)
     assert out.end == "abort" and "timed out after 0.05 s" in out.message
+
+
+def test_a_timeout_longer_than_a_timer_can_wait_is_waited_without_error(wait, monkeypatch):
+    """A goal with timeout 1e300 s (finite, so accepted) killed the deadline's timer thread with
+    OverflowError (a traceback in the job's log) before this was fixed."""
+    errors = []
+    monkeypatch.setattr(threading, "excepthook", errors.append)
+    d = device_with(1)
+    threading.Timer(0.05, lambda: [d.tick(None, 0.6) for _ in range(3)]).start()
+    out = wait(d, Goal(1, timeout=1e300), period=10.0)
+    assert out.end == "succeed" and out.completed
+    assert [e.exc_type for e in errors] == []
+
+
+def test_closing_the_watch_ends_a_pending_wait_aborted_with_why(ros):
+    """What the process does to the goals it holds when it stops (`end_goals`)."""
+    d = device_with(1)
+    watch = device_watch(ros.node, d, 10.0)
+    task = ros.executor.create_task(wait_for_motion(Handle(Goal(1)), d, watch,
+                                                    lambda *status: None))
+    threading.Timer(0.05, watch.close, ["the node shuts down"]).start()
+    assert ros.wait(task, 5.0), "the wait never ended"
+    out = task.result()
+    assert out.aborted and not out.completed and out.message == "the node shuts down"
+    assert watch.idle

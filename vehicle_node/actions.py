@@ -25,6 +25,7 @@ class WaitMotionServer:
     def __init__(self, plane: Plane, core: VehicleCore, config: WaitConfig) -> None:
         self.core = core
         self.watch = device_watch(plane, core.device, 1.0 / config.wait_feedback_rate_hz)
+        plane.goal_ends.append(self.watch)
         slots = GoalSlots(plane.owner, config.max_wait_goals, "max_wait_goals")
         self.server = action_server(plane, VehicleWaitMotion, plane.name("wait_motion"),
                                    slots.holding(self._wait), goal_callback=slots.admit,

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import traceback
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Callable, Protocol
 
 from rclpy.action import ActionServer
 from rclpy.node import Node
@@ -25,6 +25,16 @@ class Operation:
     srv_type: type
 
 
+class GoalEnd(Protocol):
+    """What ends the goals an action server holds when the process stops
+    (`acti_bringup.serving.waiting.end_goals`)."""
+
+    def close(self, why: str) -> None: ...
+
+    @property
+    def idle(self) -> bool: ...
+
+
 class Plane(Node):
     """A node that holds part of a device node's entities so that another executor serves them
     (`acti_bringup.serving.spinning`): "motion" (planning services, command topics) or "goals" (action
@@ -35,6 +45,7 @@ class Plane(Node):
         super().__init__(f"_{owner.get_name()}_{plane}", namespace=owner.get_namespace(),
                          start_parameter_services=False)
         self.owner, self.plane = owner, plane
+        self.goal_ends: list[GoalEnd] = []
 
     def name(self, entity: str) -> str:
         """`~/entity` of the device node, as an absolute name."""

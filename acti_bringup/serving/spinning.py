@@ -59,10 +59,19 @@ def stop_requested() -> bool:
     return _stop_requested.is_set()
 
 
+USAGE_TAIL = ("ROS arguments: --ros-args -r __ns:=/robot1 -p name:=value "
+              "--params-file config/acti_ros2.yaml (README.md: Parameters)")
+
+
 def init(args: list[str]) -> None:
     """rclpy.init with this module's signal handling instead of rclpy's. ROS arguments rcl
     refuses (a remap it cannot parse, a parameters file it cannot read) end the process as a
-    refused setting does (`build_or_exit`)."""
+    refused setting does (`build_or_exit`). `-h`/`--help` prints the usage and exits: it
+    started a robot, in whatever domain the shell had."""
+    own = args[1:args.index("--ros-args")] if "--ros-args" in args else args[1:]
+    if {"-h", "--help"} & set(own):
+        print(f"{(sys.modules['__main__'].__doc__ or '').strip()}\n\n{USAGE_TAIL}")
+        raise SystemExit(0)
     catch_signals()
     try:
         rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)

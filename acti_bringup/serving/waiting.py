@@ -13,16 +13,20 @@ import math
 import threading
 import time
 from dataclasses import dataclass
-from typing import Any, Awaitable, Callable, Generic, TypeVar
+from typing import Any, Awaitable, Callable, Generic, Iterable, TypeVar
 
 from rclpy.action import CancelResponse, GoalResponse
 from rclpy.node import Node
 from rclpy.task import Future
 
+from acti_bringup.serving.adapter import Plane
 from acti_bringup.serving.spinning import steady_timer
 from acti_motion.executor import Device
 
 T = TypeVar("T")
+SHUTDOWN = "the node shuts down: send the goal again once it is back"
+GOALS_END_S = 3.0       # the longest wait for the goals to end (a program's: the arm at rest)
+RESULTS_SENT_S = 0.2    # for the goal plane to send the results, and DDS to deliver them
 
 
 class GoalSlots:
@@ -55,6 +59,7 @@ class _Wait(Generic[T]):
     outcome: Callable[[], T | None]
     feedback: Callable[[], None]
     future: Future
+    closed: Callable[[str], T] | None
 
 
 class Watch:
@@ -66,6 +71,7 @@ class Watch:
         self._timer = steady_timer(node, period, self._tick)
         self._timer.cancel()                     # ticks only while something waits
         self._closing = node.context.ok
+        self._closed: str | None = None
 
     def poke(self) -> None:
         """Re-check the conditions soon (any thread; cheap and non-blocking)."""
@@ -75,22 +81,40 @@ class Watch:
             if self._closing():                 # gone with the node at shutdown: nothing waits
                 raise
 
-    async def until(self, outcome: Callable[[], T | None], feedback: Callable[[], None]) -> T:
+    async def until(self, outcome: Callable[[], T | None], feedback: Callable[[], None],
+                    closed: Callable[[str], T] | None = None) -> T:
         """Wait until `outcome()` is not None (checked on pokes and ticks), calling `feedback()`
-        every tick meanwhile; its value."""
-        now = outcome()
+        every tick meanwhile; its value. Once the watch is closed, `closed(why)` instead, if
+        given (else the wait goes on: something else ends it)."""
+        wait = _Wait(outcome, feedback, Future(), closed)
+        now = self._check(wait)
         if now is not None:
             return now
-        wait = _Wait(outcome, feedback, Future())
         self._waits.append(wait)
         if self._timer.is_canceled():
             self._timer.reset()
         return await wait.future
 
+    def close(self, why: str) -> None:
+        """The node stops: every wait that can end so ends now with `closed(why)` (any thread),
+        so that the goals held are answered before the process goes."""
+        self._closed = why
+        self.poke()
+
+    @property
+    def idle(self) -> bool:
+        """Nothing waits."""
+        return not self._waits
+
+    def _check(self, wait: _Wait) -> Any:
+        if self._closed is not None and wait.closed is not None:
+            return wait.closed(self._closed)
+        return wait.outcome()
+
     def _settle(self) -> list[_Wait]:
         pending = []
         for wait in self._waits:
-            now = wait.outcome()
+            now = self._check(wait)
             if now is None:
                 pending.append(wait)
             else:
@@ -103,6 +127,22 @@ class Watch:
     def _tick(self) -> None:
         for wait in self._settle():
             wait.feedback()
+
+
+def end_goals(planes: Iterable[Plane], why: str = SHUTDOWN) -> None:
+    """End every goal the planes' action servers hold, and give their results time to reach
+    the clients: a goal that dies with the process unanswered keeps its client waiting for
+    ever (rclcpp ends a goal handle destroyed unfinished; rclpy does not). Before the
+    simulation stops, so that a program's run ends with the arm at rest."""
+    ends = [end for plane in planes for end in plane.goal_ends]
+    if all(end.idle for end in ends):
+        return
+    for end in ends:
+        end.close(why)
+    deadline = time.monotonic() + GOALS_END_S
+    while not all(end.idle for end in ends) and time.monotonic() < deadline:
+        time.sleep(0.01)
+    time.sleep(RESULTS_SENT_S)
 
 
 def accept_cancel(watch: Watch) -> Callable[[Any], CancelResponse]:
@@ -174,13 +214,16 @@ async def wait_for_motion(goal_handle: Any, device: Device, watch: Watch,
             return WaitOutcome(target, "abort", message=f"timed out after {goal.timeout:g} s")
         return None
     # the deadline pokes the watch itself: checked on the feedback tick alone, a timeout was
-    # answered up to a feedback period late (0.01 s: 0.106 s)
-    alarm = threading.Timer(goal.timeout, watch.poke) if goal.timeout > 0 else None
+    # answered up to a feedback period late (0.01 s: 0.106 s). A timer cannot wait longer than
+    # TIMEOUT_MAX (~292 years; beyond, it dies of OverflowError): the tick checks such a deadline.
+    timed = 0 < goal.timeout <= threading.TIMEOUT_MAX
+    alarm = threading.Timer(goal.timeout, watch.poke) if timed else None
     if alarm is not None:
         alarm.daemon = True
         alarm.start()
     try:
-        return await watch.until(outcome, lambda: feedback(*device.status()))
+        return await watch.until(outcome, lambda: feedback(*device.status()),
+                                 closed=lambda why: WaitOutcome(target, "abort", message=why))
     finally:
         if alarm is not None:
             alarm.cancel()

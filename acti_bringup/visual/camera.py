@@ -28,6 +28,7 @@ from acti_bringup.serving.parameters import declare_config
 from acti_bringup.visual.transforms import link_transform, static_tf_publisher
 from acti_motion.executor import MotionExecutor
 from acti_motion.arm.poses import quaternion_xyzw
+from acti_motion.config_fields import ranged
 from acti_motion.link_poses import LinkTransform
 from acti_sim.world import World
 
@@ -38,10 +39,10 @@ MAX_PIXELS = 1920 * 1080
 
 @dataclass
 class CameraConfig:
-    camera_rate_hz: float = 0.0        # images per second of simulated time on ~/camera/image_raw; 0: no camera (rendering costs CPU)
-    camera_width: int = 320            # image width [px]
-    camera_height: int = 240           # image height [px]
-    camera_fov_deg: float = 60.0       # vertical field of view [degree]
+    camera_rate_hz: float = ranged(0.0, 0.0, 2000.0)   # images per second of simulated time on ~/camera/image_raw; 0: no camera (rendering costs CPU)
+    camera_width: int = ranged(320, 1, MAX_PIXELS)     # image width [px]
+    camera_height: int = ranged(240, 1, MAX_PIXELS)    # image height [px]
+    camera_fov_deg: float = ranged(60.0, 0.1, 179.9)   # vertical field of view [degree]
     camera_eye: tuple[float, ...] = (1.6, -1.3, 1.2)      # camera position in odom (the world at start) [m]
     camera_target: tuple[float, ...] = (0.2, 0.0, 0.65)   # the point it looks at, in odom [m]
 
@@ -54,8 +55,6 @@ def check_camera(c: CameraConfig) -> None:
     if not (0 < c.camera_width and 0 < c.camera_height
             and c.camera_width * c.camera_height <= MAX_PIXELS):
         raise ValueError(f"camera_width × camera_height must be positive, at most {MAX_PIXELS} px")
-    if not 0 < c.camera_fov_deg < 180:
-        raise ValueError("camera_fov_deg must be in (0, 180)")
     if len(c.camera_eye) != 3 or len(c.camera_target) != 3:
         raise ValueError("camera_eye and camera_target are x, y, z")
     view = np.subtract(c.camera_target, c.camera_eye)
