@@ -8,8 +8,6 @@ from __future__ import annotations
 import math
 import os
 import re
-import subprocess
-import sys
 import time
 from dataclasses import dataclass
 from typing import Any, Callable
@@ -20,6 +18,7 @@ from acti_msgs.action import Move, VehicleWaitMotion, WaitMotion
 from action_msgs.msg import GoalStatus
 from rosgraph_msgs.msg import Clock
 
+from acti_bringup.harness import FELL_BEHIND, OneShotClients
 from ros_harness import Actions, node_fixture, wait_until
 
 ARM_GOALS, BASE_GOALS = 3, 2
@@ -216,15 +215,6 @@ def test_wait_motion_refuses_a_timeout_that_is_not_finite_and_positive(ros, devi
     assert "finite number of seconds" in message
 
 
-# one `ros2 service call`: a DDS participant that starts, asks once and ends
-ONE_CALL = """import sys, rclpy
-from acti_msgs.srv import GetState
-rclpy.init()
-node = rclpy.create_node("one_call")
-client = node.create_client(GetState, sys.argv[1])
-if client.wait_for_service(timeout_sec=20.0):
-    rclpy.spin_until_future_complete(node, client.call_async(GetState.Request()), timeout_sec=10.0)
-"""
 HELD_UP_MS = 200        # Fast DDS's sleep at a shared-memory port: 333 ms
 
 
@@ -237,22 +227,15 @@ def test_participants_that_come_and_go_never_hold_up_the_control_loop(ros, job):
     answers between the clients."""
     clock = ros.node.create_subscription(Clock, "/clock", lambda _msg: None, 10)
     seen = len(job.log())
-    clients, started = [], 0
+    clients = OneShotClients(ARM + "get_state")
     try:
         deadline = time.monotonic() + 15.0
         while time.monotonic() < deadline:
-            clients = [c for c in clients if c.poll() is None]
-            while len(clients) < 2:
-                clients.append(subprocess.Popen([sys.executable, "-c", ONE_CALL, ARM + "get_state"],
-                                                stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT))
-                started += 1
+            clients.keep()
             assert ros.call(srv.GetState, ARM + "get_state").return_id.id == 0
             ros.spin_until(lambda: False, 0.05)
-        for c in clients:
-            c.wait(timeout=60.0)
     finally:
-        for c in clients:
-            c.kill()
+        clients.end()
         ros.node.destroy_subscription(clock)
-    falls = [int(ms) for ms in re.findall(r"fell (\d+) ms behind", job.log()[seen:])]
-    assert started >= 6 and all(ms < HELD_UP_MS for ms in falls), (started, falls)
+    falls = [int(ms) for ms in re.findall(FELL_BEHIND, job.log()[seen:])]
+    assert clients.started >= 6 and all(ms < HELD_UP_MS for ms in falls), (clients.started, falls)
