@@ -158,31 +158,33 @@ def wait_until(predicate: Callable[[], bool], timeout: float, period: float = 0.
     return False
 
 
-# one `ros2 service call`: a DDS participant that starts, calls one GetState service and ends
-_ONE_CALL = """import sys, rclpy
-from acti_msgs.srv import GetState
+# one `ros2 service call`: a DDS participant that starts, calls one service and ends
+_ONE_CALL = """import importlib, sys, rclpy
+module, name, service = sys.argv[1:4]
+srv_type = getattr(importlib.import_module(module), name)
 rclpy.init()
 node = rclpy.create_node("one_call")
-client = node.create_client(GetState, sys.argv[1])
+client = node.create_client(srv_type, service)
 if client.wait_for_service(timeout_sec=20.0):
-    rclpy.spin_until_future_complete(node, client.call_async(GetState.Request()), timeout_sec=10.0)
+    rclpy.spin_until_future_complete(node, client.call_async(srv_type.Request()), timeout_sec=10.0)
 """
 
 
 class OneShotClients:
-    """Keep `count` one-shot client processes (`_ONE_CALL` on `service`) running, a new one as
-    soon as one ends, while `keep()` is called: DDS participants that come and go, as every
-    `ros2` command is one."""
+    """Keep `count` one-shot client processes (`_ONE_CALL`: one call of `service`, of type
+    `srv_type` whose request needs no field) running, a new one as soon as one ends, while
+    `keep()` is called: DDS participants that come and go, as every `ros2` command is one."""
 
-    def __init__(self, service: str, count: int = 2) -> None:
-        self.service, self.count, self.started = service, count, 0
+    def __init__(self, srv_type: type, service: str, count: int = 2) -> None:
+        self.call = [srv_type.__module__.rsplit(".", 1)[0], srv_type.__name__, service]
+        self.count, self.started = count, 0
         self._running: list[subprocess.Popen] = []
 
     def keep(self) -> None:
         self._running = [c for c in self._running if c.poll() is None]
         while len(self._running) < self.count:
             self._running.append(subprocess.Popen(
-                [sys.executable, "-c", _ONE_CALL, self.service],
+                [sys.executable, "-c", _ONE_CALL, *self.call],
                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, preexec_fn=_end_with_parent))
             self.started += 1
 

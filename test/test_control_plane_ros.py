@@ -227,7 +227,7 @@ def test_participants_that_come_and_go_never_hold_up_the_control_loop(ros, job):
     answers between the clients."""
     clock = ros.node.create_subscription(Clock, "/clock", lambda _msg: None, 10)
     seen = len(job.log())
-    clients = OneShotClients(ARM + "get_state")
+    clients = OneShotClients(srv.GetState, ARM + "get_state")
     try:
         deadline = time.monotonic() + 15.0
         while time.monotonic() < deadline:
