@@ -293,3 +293,21 @@ def test_registrations_flags_and_channel_data_count_as_data_held(step: str) -> N
     program = (f'.name s %1005 .name y %1006 .name n %1007 VAR #s #n DCL #s "{"A" * 1000}" STORE '
                f"#n I4:1 STORE #f Fn{{ top: {step} >top BRA END }} STORE f")
     assert error_of(program, budget=None, memory_limit=1_000_000).kind is K.MEMORY_EXHAUSTED
+
+
+@pytest.mark.parametrize("program, code", [
+    ("#x Rd<7ff0000000000000> STORE #x 0 #R8 EXTB", "EF54"),   # EXTB: the bytes are no R8
+    ("#x 1.0 STORE #x 0 Rd<7ff0000000000000> EMBB x", "1000"),  # x read after the write
+    ("#x Ar[R8 1.0] STORE #x 0 Rd<7ff0000000000000> EMBB #x 0 EXTE", "EF56"),
+])
+def test_data_that_is_no_number_at_run_time_is_reported_where_it_is_read(program: str,
+                                                                         code: str) -> None:
+    """§4.5: the report names the code where the program stopped. Bytes read as a real at run
+    time (EXTB, EXTE, a variable rebuilt after EMBB) that are no number (Reference 2: no NaN,
+    no ∞) were reported at byte 0, the offset inside the datum, not in the program."""
+    program_bytes = assemble(PRELUDE + program)
+    with pytest.raises(StrolicError) as caught:
+        VM(RecordingHost()).run(program_bytes)
+    assert caught.value.kind is K.INVALID_CODE
+    offset = caught.value.offset
+    assert program_bytes[offset:offset + 2] == bytes.fromhex(code), caught.value.report()
