@@ -24,7 +24,9 @@ def _state(proc: Process | None) -> Num:
 
 
 def _process(vm, number: int) -> Process | None:
-    return vm.processes.get(number)
+    """The process FXQT started under ``number``: process numbers are positive (EF76), so the
+    program itself (kept as 0) is none of them and cannot be killed, suspended or restarted."""
+    return vm.processes.get(number) if number > 0 else None
 
 
 # ---- processes ----------------------------------------------------------------------------------

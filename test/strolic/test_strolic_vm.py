@@ -311,3 +311,19 @@ def test_data_that_is_no_number_at_run_time_is_reported_where_it_is_read(program
     assert caught.value.kind is K.INVALID_CODE
     offset = caught.value.offset
     assert program_bytes[offset:offset + 2] == bytes.fromhex(code), caught.value.report()
+
+
+@pytest.mark.parametrize("program, expected", [
+    ("0 FKILL 5", ["I2:1", "5"]),                   # 1: process 0 is not executing
+    ("#f Fn{ 0 FKILL END } STORE #f 1 FXQT DROP 2 1 1 5 IOWAIT DROP DROP 5", ["5"]),
+    ("0 FSUSPEND 5", ["I2:1", "5"]),
+    ("#f Fn{ 0 FSUSPEND END } STORE #f 1 FXQT DROP 2 1 1 5 IOWAIT DROP DROP 5", ["5"]),
+    ("0 FRESUME", ["I2:1"]), ("0 FDONE", ["I2:0"]), ("0 5 FPRECD", ["I2:0"]),
+    ("0 10 FCYCLE", ["I2:0"]),
+])
+def test_the_program_is_no_process_number(program: str, expected: list[str]) -> None:
+    """EF76 FXQT: process numbers are positive integers (0 and below are refused, −2). The
+    program itself has none: FKILL 0 ended the program as if it had ended normally (its
+    stack kept, the rest not run), FSUSPEND 0 made every process wait (deadlock), FCYCLE 0
+    restarted the program. Functions EF78–EF82 treat 0 as a number no process has."""
+    assert stack_of(program) == expected
