@@ -145,11 +145,16 @@ def _flag_on(vm: VM, number: int) -> None:
         vm.flags.add(number)
 
 
+MAX_FLAG = 32767    # EPOP gives a flag number as I2 (EF89)
+
+
 def flag_number(item) -> int:
-    """Event-flag and channel numbers are positive (EPOP uses 0 for 'no event')."""
+    """Event-flag and channel numbers are positive (EPOP uses 0 for 'no event') and fit the
+    I2 that EPOP pushes."""
     number = integer_value(expect(item, Num, "an event-flag number"))
-    if number <= 0:
-        raise fail(K.UNDEFINED_DATA, f"event flag {number} does not exist")
+    if not 0 < number <= MAX_FLAG:
+        raise fail(K.UNDEFINED_DATA, f"event flag {number:.6g} does not exist (flags are "
+                                     f"1 … {MAX_FLAG}: EPOP gives them as I2)")
     return number
 
 

@@ -340,8 +340,11 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
     "EWAITO": [("2 ESIG 1 2 2 EWAITO EPOP EPOP", ["I2:2", F]),
                ("1 ESIG 3 ESIG 1 2 3 3 EWAITO EPOP EPOP EPOP", [T, "I2:3", F]),
                ("1 2 2 EWAITO", DEAD)],
-    "EPOP": [("EPOP", [F])],
-    "ESIG": [("1 ESIG 1 EWAIT 7", ["7"]), ("-1 ESIG", UNDEF), ("1.4 ESIG 1 EWAIT 7", ["7"])],
+    # EPOP gives a flag number as I2 (EF89), so flag numbers end at 32767: a flag 70000 came
+    # back as an I2 that no I2 holds (RESULT of it stopped with a Python error)
+    "EPOP": [("EPOP", [F]), ("I2:32767 ESIG I2:32767 1 EWAITO EPOP", ["32767"])],
+    "ESIG": [("1 ESIG 1 EWAIT 7", ["7"]), ("-1 ESIG", UNDEF), ("1.4 ESIG 1 EWAIT 7", ["7"]),
+             ("I4:32768 ESIG", UNDEF), ("1e300 ESIG", UNDEF)],
     "ECLR": [("1 ESIG 2 ESIG 1 1 ECLR 2 EWAIT 1 EWAIT", DEAD), ("1 ESIG 0 ECLR 1 EWAIT", DEAD),
              ("1 ESIG 2 ESIG 0 ECLR 3", ["3"]), ("1 ESIG 1 1 ECLR 1 ESIG 1 EWAIT 4", ["4"])],
     "CHIN": [('1 "hi" CHOUT 1 CHIN', ['"hi"']), ("1 CHIN", DEAD), ("1 ESIG 1 CHIN", UNDEF),
