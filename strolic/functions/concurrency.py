@@ -47,9 +47,17 @@ def fxqt(vm: VM, proc: Process) -> None:
     proc.push(Num(I2, 0))
 
 
+def _pop_at_least(proc: Process, lowest: int, what: str) -> int:
+    """A process setting the standard gives a range (EF78 priority ≥ 1, EF7A period ≥ 0)."""
+    value = pop_count(proc)
+    if value < lowest:
+        raise fail(K.UNDEFINED_DATA, f"{what} {value} (at least {lowest})")
+    return value
+
+
 def fprecd(vm: VM, proc: Process) -> None:
     """FPRECD a b: priority b (smaller runs first) for process a; the result is its state."""
-    priority = pop_count(proc)
+    priority = _pop_at_least(proc, 1, "priority")
     target = _process(vm, pop_count(proc))
     if target is not None:
         target.priority = priority
@@ -59,10 +67,10 @@ def fprecd(vm: VM, proc: Process) -> None:
 def fcycle(vm: VM, proc: Process) -> None:
     """FCYCLE a b: process a restarts every b ms (measured from its starts; a period that
     passes while it still runs is skipped); 0 ends the cyclic start."""
-    period = pop_count(proc)
+    period = _pop_at_least(proc, 0, "cyclic-start period (ms)")
     target = _process(vm, pop_count(proc))
     if target is not None:
-        target.period = max(period, 0) / 1000.0
+        target.period = period / 1000.0
         target.next_start = vm.host.now()
     proc.push(_state(target))
 

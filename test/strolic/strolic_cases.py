@@ -309,10 +309,14 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
              ("#x 5 STORE #x 1 FXQT", ["I2:-1"]), ("#f Fn{ END } STORE #f 0 FXQT", ["I2:-2"]),
              (f"{FN_WAIT} #f 1 FXQT #f 1 FXQT", [F, "I2:-2"]),
              ("#f Fn{ END } STORE #f PUSH 2 FXQT", [F])],
-    "FPREDC": [(f"{FN_WAIT} #f 1 FXQT 1 5 FPREDC", [F, T]), ("9 5 FPREDC", [F])],
+    # EF78: "the priority b is a positive integer" (−5 ran the process before all others)
+    "FPREDC": [(f"{FN_WAIT} #f 1 FXQT 1 5 FPREDC", [F, T]), ("9 5 FPREDC", [F]),
+               (f"{FN_WAIT} #f 1 FXQT 1 -5 FPREDC", UNDEF), ("9 0 FPREDC", UNDEF)],
     "FCYCLE": [("#x 0 STORE #f Fn{ #x x INC STORE END } STORE #f 1 FXQT DROP 1 5 FCYCLE DROP "
                 "#g Fn{ top: x 3 LT >top BRT END } STORE g 1 0 FCYCLE x 3 GEQ",
-                ["I2:2", T]), ("9 10 FCYCLE", [F])],
+                ["I2:2", T]), ("9 10 FCYCLE", [F]),
+               # EF7A: the period is a positive integer, 0 none (−10 stopped the cycle as 0)
+               ("9 -10 FCYCLE", UNDEF)],
     "FDONE": [(f"{FN_WAIT} #f 1 FXQT 1 FDONE", [F, T]), ("7 FDONE", [F])],
     "FKILL": [(f"{FN_WAIT} #f 1 FXQT DROP 1 FKILL 1 FDONE 1 FKILL", [F, F, T])],
     "FSUSPEND": [(f"{FN_WAIT} #f 1 FXQT DROP 1 FSUSPEND 1 FDONE 1 FSUSPEND", [F, "I2:3", T]),
