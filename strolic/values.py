@@ -14,7 +14,7 @@ from .codes import (ARRAY, FIXED_SIZE, FUNCTION, I1, INDIRECT, INT_FORMAT, INTEG
                     LENGTH_TAGS, NUMERIC_TAGS, POSE, R4, R8, REAL_FORMAT, RECORD, STRING,
                     SUPPRESS, TAG_NAMES, TRANSFORM, VECTOR, Array, Function, FunctionCode, Num,
                     Pose, Record, Str, TagHead, Trn, UserCode, Vec, smallest_int)
-from .errors import ExceptionKind as K, StrolicError, fail
+from .errors import ExceptionKind as K, fail, read_at
 
 
 # Bytes counted for a registration without an area, and for an event flag that is on: what
@@ -206,12 +206,10 @@ def value_from_data(head: TagHead, data: bytes, offset: int | None = None) -> ob
     """The value that ``head`` and its data part ``data`` describe (data of the exact size).
     ``offset`` is where the data part stands in the program; data made at run time (EXTB, EXTE,
     an area after EMBB) has none, so that an error is located at the code that reads it."""
-    try:
+    if head.tag == FUNCTION:
+        return Function(bytes(data), offset)
+    with read_at(offset):
         return _value_from_data(head, data, offset or 0)
-    except StrolicError as error:
-        if offset is None:
-            error.offset = None
-        raise
 
 
 def _value_from_data(head: TagHead, data: bytes, offset: int) -> object:
@@ -222,8 +220,6 @@ def _value_from_data(head: TagHead, data: bytes, offset: int) -> object:
         return Str(bytes(data))
     if tag == RECORD:
         return Record(bytes(data))
-    if tag == FUNCTION:
-        return Function(bytes(data), offset)
     if tag in (VECTOR, TRANSFORM):
         count = 3 if tag == VECTOR else 12
         values = struct.unpack(f">{count}f", data)

@@ -9,8 +9,8 @@ import re
 from typing import TYPE_CHECKING
 
 from ..codes import (ARRAY, I2, INT_RANGE, NUMERIC_TAGS, POSE, R4, R8, RECORD, STRING, TAG_NAMES,
-                     TRANSFORM, VECTOR, Array, Num, Pose, Record, Str, TagHead, Trn, UserCode,
-                     Vec, make_number, round_half_away, type_name, user_key)
+                     TRANSFORM, VECTOR, Array, Function, Num, Pose, Record, Str, TagHead, Trn,
+                     UserCode, Vec, make_number, round_half_away, type_name, user_key)
 from ..errors import ExceptionKind as K, StrolicError, fail
 from ..formatting import assignments, basic_encode, c_decode, c_encode, conversion_error
 from ..literals import format_head
@@ -38,7 +38,8 @@ def text_datum(text: bytes):
     except (StrolicError, UnicodeDecodeError):
         return None
     if len(codes) == 1 and codes[0].kind is CodeKind.DATA:
-        return codes[0].value
+        value = codes[0].value      # a function read from text has no place in the program
+        return Function(value.body) if isinstance(value, Function) else value
     return None
 
 

@@ -327,3 +327,20 @@ def test_the_program_is_no_process_number(program: str, expected: list[str]) -> 
     stack kept, the rest not run), FSUSPEND 0 made every process wait (deadlock), FCYCLE 0
     restarted the program. Functions EF78–EF82 treat 0 as a number no process has."""
     assert stack_of(program) == expected
+
+
+@pytest.mark.parametrize("program", [
+    '#g "Fn{ 1 0 DIV END }" #Fn(0) DECODE1 STORE 1 2 g',             # a body read from text
+    "2 #Fn(0) #g ALLOC DROP g",                       # an Fn area of zero bytes: invalid code
+    '#f Fn{ 7 g END } STORE #g "Fn{ 1 0 DIV END }" #Fn(0) DECODE1 STORE f',   # called by f
+])
+def test_an_exception_in_a_function_made_at_run_time_is_located_where_it_was_called(
+        program: str) -> None:
+    """§4.5: the report names the code where the program stopped. A function made at run
+    time (DECODE1, an Fn area) has no bytes in the program; its offsets inside its own body
+    (and those of the throwaway text DECODE1 read) were reported as program offsets."""
+    program_bytes = assemble(PRELUDE + program)
+    with pytest.raises(StrolicError) as caught:
+        VM(RecordingHost()).run(program_bytes)
+    offset = caught.value.offset
+    assert program_bytes[offset:offset + 2] == bytes.fromhex("1003"), caught.value.report()
