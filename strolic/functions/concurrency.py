@@ -153,6 +153,16 @@ def _flag_on(vm: VM, number: int) -> None:
         vm.flags.add(number)
 
 
+def _flags_off(vm: VM, numbers) -> None:
+    """Flags off. A channel is full while its flag is on (choice 37): one turned off by other
+    means than CHIN (ECLR, UNLOCK, an EWAIT) is empty, its datum dropped, so that a later
+    ESIG does not bring the cleared datum back."""
+    for number in numbers:
+        vm.flags.discard(number)
+        vm.channels.pop(number, None)
+    vm.changed()
+
+
 MAX_FLAG = 32767    # EPOP gives a flag number as I2 (EF89)
 
 
@@ -194,8 +204,7 @@ def unlock(vm: VM, proc: Process) -> None:
     if number not in vm.flags:
         proc.push(Num(I2, 1))
         return
-    vm.flags.discard(number)
-    vm.changed()
+    _flags_off(vm, [number])
     proc.push(Num(I2, 0))
 
 
@@ -204,8 +213,7 @@ def ewait(vm: VM, proc: Process):
     if number not in vm.flags:
         return WAIT
     proc.pop()
-    vm.flags.discard(number)
-    vm.changed()
+    _flags_off(vm, [number])
     return None
 
 
@@ -215,8 +223,7 @@ def ewaita(vm: VM, proc: Process):
     if not vm.flags.issuperset(numbers):
         return WAIT
     _take_flags(proc, len(numbers))
-    vm.flags.difference_update(numbers)
-    vm.changed()
+    _flags_off(vm, numbers)
     return None
 
 
@@ -230,8 +237,7 @@ def ewaito(vm: VM, proc: Process):
         return WAIT
     _take_flags(proc, len(numbers))
     proc.event_buffer.extend(occurred)
-    vm.flags.difference_update(occurred)
-    vm.changed()
+    _flags_off(vm, occurred)
     return None
 
 
@@ -249,10 +255,7 @@ def eclr(vm: VM, proc: Process) -> None:
     """ECLR a1 … an n: those flags off; n = 0 turns every flag off."""
     count = pop_count(proc)
     numbers = [flag_number(item) for item in pop_many(proc, count)]
-    if count == 0:
-        vm.flags.clear()
-    vm.flags.difference_update(numbers)
-    vm.changed()
+    _flags_off(vm, list(vm.flags) if count == 0 else numbers)
 
 
 # ---- channels -----------------------------------------------------------------------------------

@@ -350,7 +350,10 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
     "ESIG": [("1 ESIG 1 EWAIT 7", ["7"]), ("-1 ESIG", UNDEF), ("1.4 ESIG 1 EWAIT 7", ["7"]),
              ("I4:32768 ESIG", UNDEF), ("1e300 ESIG", UNDEF)],
     "ECLR": [("1 ESIG 2 ESIG 1 1 ECLR 2 EWAIT 1 EWAIT", DEAD), ("1 ESIG 0 ECLR 1 EWAIT", DEAD),
-             ("1 ESIG 2 ESIG 0 ECLR 3", ["3"]), ("1 ESIG 1 1 ECLR 1 ESIG 1 EWAIT 4", ["4"])],
+             ("1 ESIG 2 ESIG 0 ECLR 3", ["3"]), ("1 ESIG 1 1 ECLR 1 ESIG 1 EWAIT 4", ["4"]),
+             # a channel cleared is empty: ESIG then CHIN found the cleared datum again
+             ("1 5 CHOUT 0 ECLR 1 ESIG 1 CHIN", UNDEF), ("1 5 CHOUT 1 1 ECLR 1 ESIG 1 CHIN", UNDEF),
+             ("1 5 CHOUT 1 UNLOCK DROP 1 ESIG 1 CHIN", UNDEF)],
     "CHIN": [('1 "hi" CHOUT 1 CHIN', ['"hi"']), ("1 CHIN", DEAD), ("1 ESIG 1 CHIN", UNDEF),
              ("#f Fn{ 1 1 CHOUT 1 2 CHOUT 1 3 CHOUT END } STORE #f 1 FXQT DROP "
               "1 CHIN 1 CHIN 1 CHIN", ["1", "2", "3"])],
