@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ..codes import I2, Num, user_key
+from ..codes import I2, I4, INT_RANGE, Num, user_key
 from ..errors import ExceptionKind as K, fail
 from ..process import CYCLE_WAIT, RETRY, WAIT, Process, State
 from ..values import ENTRY_BYTES
@@ -31,14 +31,16 @@ def _process(vm, number: int) -> Process | None:
 
 # ---- processes ----------------------------------------------------------------------------------
 def fxqt(vm: VM, proc: Process) -> None:
-    """FXQT #a b: 0 started, −1 a is not a function, −2 number not usable (≤ 0 or busy)."""
+    """FXQT #a b: 0 started, −1 a is not a function, −2 number not usable (≤ 0, beyond I4,
+    or busy)."""
     number = pop_count(proc)
     target = function_of(proc, proc.pop())
     if target is None:
         proc.push(Num(I2, -1))
         return
     running = _process(vm, number)
-    if number <= 0 or (running is not None and running.state is not State.DONE):
+    busy = running is not None and running.state is not State.DONE
+    if busy or not 0 < number <= INT_RANGE[I4][1]:
         proc.push(Num(I2, -2))
         return
     frame = vm.function_frame(target, f"process {number}")

@@ -308,7 +308,9 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
     "FXQT": [("#f Fn{ 1 ESIG END } STORE #f 1 FXQT 1 EWAIT 1 FDONE", [F, F]),
              ("#x 5 STORE #x 1 FXQT", ["I2:-1"]), ("#f Fn{ END } STORE #f 0 FXQT", ["I2:-2"]),
              (f"{FN_WAIT} #f 1 FXQT #f 1 FXQT", [F, "I2:-2"]),
-             ("#f Fn{ END } STORE #f PUSH 2 FXQT", [F])],
+             ("#f Fn{ END } STORE #f PUSH 2 FXQT", [F]),
+             # a process number is an integer of STROLIC (at most an I4), as a file number is
+             ("#f Fn{ END } STORE #f 1e300 FXQT", ["I2:-2"])],
     # EF78: "the priority b is a positive integer" (−5 ran the process before all others)
     "FPREDC": [(f"{FN_WAIT} #f 1 FXQT 1 5 FPREDC", [F, T]), ("9 5 FPREDC", [F]),
                (f"{FN_WAIT} #f 1 FXQT 1 -5 FPREDC", UNDEF), ("9 0 FPREDC", UNDEF)],
