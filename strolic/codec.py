@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from . import opcodes
 from .codes import (END_CODE, FUNCTION, INDIRECT, SUPPRESS, Function, FunctionCode, TagHead,
                     UserCode, is_user_code)
+from .errors import read_at
 from .values import (MAX_NESTING, Reader, data_of, encode_function_code, encode_head, encode_item,
                      encode_value, invalid, value_from_data)
 
@@ -101,8 +102,10 @@ def decode(data: bytes, base: int = 0, *, function_body: bool = False,
 
 
 def decode_function(function: Function) -> list[Code]:
-    """The codes of a function body, offsets relative to where it was read (or to its start)."""
-    return decode(function.body, function.origin or 0, function_body=True)
+    """The codes of a function body, offsets relative to where it was read (or to its start:
+    a body made at run time has no place in the program, see ``read_at``)."""
+    with read_at(function.origin):
+        return decode(function.body, function.origin or 0, function_body=True)
 
 
 def encode_code(code: Code) -> bytes:

@@ -6,7 +6,9 @@ say where execution stopped (§4.5: the program stops and the exception is repor
 """
 from __future__ import annotations
 
+import contextlib
 import enum
+from typing import Iterator
 
 
 class ExceptionKind(enum.Enum):
@@ -101,3 +103,16 @@ class StrolicError(Exception):
 def fail(kind: ExceptionKind, detail: str = "") -> StrolicError:
     """Build the error to raise; short to write at every check."""
     return StrolicError(kind, detail)
+
+
+@contextlib.contextmanager
+def read_at(origin: int | None) -> Iterator[None]:
+    """Decoding a datum read at ``origin`` of the program: its errors carry program offsets.
+    A datum made at run time (EXTB, EMBB into an area, DECODE1) has no place in the program:
+    its errors lose the offset, and the VM puts the one of the code that used the datum."""
+    try:
+        yield
+    except StrolicError as error:
+        if origin is None:
+            error.offset = None
+        raise

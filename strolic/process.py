@@ -27,11 +27,13 @@ class State(enum.IntEnum):
 
 
 class Frame:
-    """Executing code: a function body (``function`` set) or the program itself."""
+    """Executing code: a function body (``function`` set) or the program itself; ``origin``
+    is where the body stands in the program (None for one made at run time)."""
 
     __slots__ = ("codes", "pc", "origin", "function", "name", "_positions")
 
-    def __init__(self, codes: list, origin: int, function: Function | None, name: str) -> None:
+    def __init__(self, codes: list, origin: int | None, function: Function | None,
+                 name: str) -> None:
         self.codes = codes
         self.pc = 0
         self.origin = origin

@@ -96,6 +96,8 @@ class Assembler:
             if word == ".name":
                 self.define_name()
             elif kind == "word" and word.endswith(":") and len(word) > 1:
+                if word[:-1] in labels:
+                    raise self.error(f"label {word[:-1]!r} is defined twice")
                 labels[word[:-1]] = len(codes)
             elif kind == "word" and word.startswith(">") and len(word) > 1:
                 references.append((len(codes), word[1:], line))

@@ -14,7 +14,7 @@ from .codes import (ARRAY, FIXED_SIZE, FUNCTION, I1, INDIRECT, INT_FORMAT, INTEG
                     LENGTH_TAGS, NUMERIC_TAGS, POSE, R4, R8, REAL_FORMAT, RECORD, STRING,
                     SUPPRESS, TAG_NAMES, TRANSFORM, VECTOR, Array, Function, FunctionCode, Num,
                     Pose, Record, Str, TagHead, Trn, UserCode, Vec, smallest_int)
-from .errors import ExceptionKind as K, fail
+from .errors import ExceptionKind as K, fail, read_at
 
 
 # Bytes counted for a registration without an area, and for an event flag that is on: what
@@ -202,8 +202,17 @@ def encode_function_code(code: int) -> bytes:
     return code.to_bytes(4 if code > 0xFFFF else 2, "big")
 
 
-def value_from_data(head: TagHead, data: bytes, offset: int = 0) -> object:
-    """The value that ``head`` and its data part ``data`` describe (data of the exact size)."""
+def value_from_data(head: TagHead, data: bytes, offset: int | None = None) -> object:
+    """The value that ``head`` and its data part ``data`` describe (data of the exact size).
+    ``offset`` is where the data part stands in the program; data made at run time (EXTB, EXTE,
+    an area after EMBB) has none, so that an error is located at the code that reads it."""
+    if head.tag == FUNCTION:
+        return Function(bytes(data), offset)
+    with read_at(offset):
+        return _value_from_data(head, data, offset or 0)
+
+
+def _value_from_data(head: TagHead, data: bytes, offset: int) -> object:
     tag = head.tag
     if tag in NUMERIC_TAGS:
         return decode_number_data(tag, data, offset)
@@ -211,8 +220,6 @@ def value_from_data(head: TagHead, data: bytes, offset: int = 0) -> object:
         return Str(bytes(data))
     if tag == RECORD:
         return Record(bytes(data))
-    if tag == FUNCTION:
-        return Function(bytes(data), offset)
     if tag in (VECTOR, TRANSFORM):
         count = 3 if tag == VECTOR else 12
         values = struct.unpack(f">{count}f", data)
@@ -250,10 +257,10 @@ def _check_elements(element: TagHead, data: bytes, size: int, offset: int) -> No
         bad = np.flatnonzero(~np.isfinite(reals))
         if len(bad):
             at = int(bad[0]) * reals.itemsize // size * size
-            value_from_data(element, data[at:at + size], offset + at)    # says what is wrong
+            _value_from_data(element, data[at:at + size], offset + at)    # says what is wrong
         return
     for start in range(0, len(data), size or 1):
-        value_from_data(element, data[start:start + size], offset + start)
+        _value_from_data(element, data[start:start + size], offset + start)
 
 
 def array_elements(array: Array) -> list:

@@ -166,7 +166,7 @@ class VM:
         codes = self._compiled.get(function.body)
         if codes is None:
             codes = self._compile_body(function)
-        return Frame(codes, function.origin or 0, function, name)
+        return Frame(codes, function.origin, function, name)
 
     def _compile_body(self, function: Function) -> list:
         """A body made at run time (EMBB into an Fn area) may be megabytes, and a code takes
@@ -351,7 +351,18 @@ class VM:
             name += f" (in function {frame.name})"
         if proc.number:
             name += f" ({proc.name})"
-        return error.located(name, frame.origin + offset)
+        return error.located(name, self.program_offset(proc, frame, offset))
+
+    @staticmethod
+    def program_offset(proc: Process, frame: Frame, offset: int) -> int | None:
+        """Where the program stands: in a body made at run time (no place in the program), at
+        the code that called it."""
+        if frame.origin is not None:
+            return frame.origin + offset
+        for kind, caller in reversed(proc.returns):
+            if kind == "call" and caller.origin is not None:
+                return caller.origin + caller.codes[caller.pc - 1][2]
+        return None
 
     # ---- interrupt processes (interrupts.py) ----------------------------------------------------
     def handler_running(self, label: str) -> bool:

@@ -34,7 +34,7 @@ from acti_motion.config_fields import check_ranges, ranged
 from acti_motion.replies import Refused, ReturnCode, value_error
 from acti_motion.arm.trajectories import ArcPath, ArmSetpoint, LinePath
 from strolic.codes import (I2, NUMERIC_TAGS, POSE, R4, R8, Array, Num, Pose, Str, TagHead,
-                           Trn, make_real)
+                           Trn, make_real, type_name)
 from strolic.errors import ExceptionKind as K, StrolicError, fail
 from strolic.functions.args import integer_value, pop_many, pop_num, pop_of
 from strolic.functions.geometry import matrix_of, pose_of, pose_parts
@@ -438,16 +438,12 @@ class RobotHost(Host):
             raise Flag(FLAG_INVALID, "undefined pose: the elbow angle is not finite")
         return Target(T, configuration & CONFIGURATION_BITS, elbow)
 
-    def _targets(self, item: object) -> list[Target]:
+    def _targets(self, item: Pose | Array) -> list[Target]:
         """A Pm or an Ar of Pm (a pose sequence) as targets."""
-        if isinstance(item, Pose):
-            return [self.target_of(item)]
-        if isinstance(item, Array) and item.element.tag == POSE:
-            poses = array_elements(item)
-            if not poses:
-                raise Flag(FLAG_INVALID, "an empty pose sequence")
-            return [self.target_of(p) for p in poses]
-        raise fail(K.TYPE_MISMATCH, "a pose (Pm) or a pose sequence (Ar of Pm) expected")
+        poses = [item] if isinstance(item, Pose) else array_elements(item)
+        if not poses:
+            raise Flag(FLAG_INVALID, "an empty pose sequence")
+        return [self.target_of(p) for p in poses]
 
     @staticmethod
     def _count_of(item: object) -> int:
@@ -541,12 +537,14 @@ class RobotHost(Host):
         ratio = 100.0 * opening_mm / self.max_opening
         self._submit(lambda: self.arm.queue_gripper(ratio, label))
 
-    def _move(self, vm: VM, proc: Process, name: str, nargs: int, count: Callable[[list], int],
-              run: Callable[[list], None], ratio: float, setting: str) -> object:
-        """The frame of every motion command: its `nargs` arguments stay on the stack while the
-        queue has no room for its motions (the program waits); then they are taken and the
-        motions queued; the flag tells how it went."""
-        args = [proc.peek(i) for i in reversed(range(nargs))]
+    def _move(self, vm: VM, proc: Process, name: str, kinds: list[ArgKind],
+              count: Callable[[list], int], run: Callable[[list], None], ratio: float,
+              setting: str) -> object:
+        """The frame of every motion command: its arguments (of `kinds`, deepest first) stay on
+        the stack while the queue has no room for its motions (the program waits); then they
+        are taken and the motions queued; the flag tells how it went."""
+        args = _arguments(proc, kinds)
+        nargs = len(args)
         try:
             self._ready(ratio, setting)
             if not self._room(count(args)) or not self._queue_together(lambda: run(args)):
@@ -723,9 +721,9 @@ class RobotHost(Host):
             for target in targets:
                 (self._ptp_to if joint else self._line_to)(target, name)
         if joint:
-            return self._move(vm, proc, name, 1, lambda a: self._count_of(a[0]), run,
+            return self._move(vm, proc, name, [POSES], lambda a: self._count_of(a[0]), run,
                               self.jspeed, "JSPEED")
-        return self._move(vm, proc, name, 1, lambda a: self._count_of(a[0]), run,
+        return self._move(vm, proc, name, [POSES], lambda a: self._count_of(a[0]), run,
                           self._cartesian_ratio(), "SPEED")
 
     def ajmove(self, vm: VM, proc: Process) -> object:
@@ -747,7 +745,7 @@ class RobotHost(Host):
             for t in self._targets(args[0]):
                 self._line_to(Target(start.pose @ t.pose, start.configuration,
                                      start.elbow + t.elbow), "HMOVE")
-        return self._move(vm, proc, "HMOVE", 1, lambda a: self._count_of(a[0]), run,
+        return self._move(vm, proc, "HMOVE", [POSES], lambda a: self._count_of(a[0]), run,
                           self._cartesian_ratio(), "SPEED")
 
     def cmove1(self, vm: VM, proc: Process) -> object:
@@ -756,11 +754,9 @@ class RobotHost(Host):
         the start), orientation d (1 turns with the arc, 2 kept, 3 ends at c's)."""
         def run(args: list) -> None:
             plane, angle, centre_pose, orient = args
-            for item in (plane, angle, orient):
-                _number(item)
             plane, orient = integer_value(plane), integer_value(orient)
             sweep = math.radians(float(angle.value))
-            centre = self.target_of(_pose(centre_pose))
+            centre = self.target_of(centre_pose)
             if plane not in PLANES or orient not in (1, 2, 3):
                 raise Flag(FLAG_INVALID, f"plane {plane} (1–3) or orientation {orient} (1–3)")
             if not abs(sweep) < 2 * math.pi:
@@ -783,12 +779,13 @@ class RobotHost(Host):
             else:
                 self._cartesian_move(lambda P0: CirclePath(P0, c, axis, sweep, end, orient == 1),
                                      "CMOVE1", None)
-        return self._move(vm, proc, "CMOVE1", 4, lambda a: 1, run, self._cartesian_ratio(), "SPEED")
+        return self._move(vm, proc, "CMOVE1", [NUMBER, NUMBER, A_POSE, NUMBER], lambda a: 1, run,
+                          self._cartesian_ratio(), "SPEED")
 
     def cmove3(self, vm: VM, proc: Process) -> object:
         """a b: the arc from the start through a's position to b (b's orientation and elbow)."""
         def run(args: list) -> None:
-            via, target = (self.target_of(_pose(item)) for item in args)
+            via, target = (self.target_of(item) for item in args)
             self._same_configuration(target)
             _, start = self._start()
             b = via.pose[:3, 3]
@@ -802,11 +799,10 @@ class RobotHost(Host):
             else:
                 self._cartesian_move(lambda P0: ArcPath(P0, b, target.pose), "CMOVE3",
                                      math.radians(target.elbow))
-        return self._move(vm, proc, "CMOVE3", 2, lambda a: 1, run, self._cartesian_ratio(), "SPEED")
+        return self._move(vm, proc, "CMOVE3", [A_POSE, A_POSE], lambda a: 1, run,
+                          self._cartesian_ratio(), "SPEED")
 
-    def _joints_of(self, item: object) -> np.ndarray:
-        if not isinstance(item, Array) or item.element.tag not in NUMERIC_TAGS:
-            raise fail(K.TYPE_MISMATCH, "an array of numbers (the joint values) expected")
+    def _joints_of(self, item: Array) -> np.ndarray:
         values = np.array([float(v.value) for v in array_elements(item)])
         if len(values) != self.arm.axis_count:
             raise Flag(FLAG_INVALID, f"{len(values)} joint values, the arm has "
@@ -817,13 +813,13 @@ class RobotHost(Host):
         def run(args: list) -> None:
             goal = self._joints_of(args[0])
             self._joint_move(lambda start: goal, "ADRIVE")
-        return self._move(vm, proc, "ADRIVE", 1, lambda a: 1, run, self.jspeed, "JSPEED")
+        return self._move(vm, proc, "ADRIVE", [JOINTS], lambda a: 1, run, self.jspeed, "JSPEED")
 
     def idrive(self, vm: VM, proc: Process) -> object:
         def run(args: list) -> None:
             delta = self._joints_of(args[0])
             self._joint_move(lambda start: start.joints + delta, "IDRIVE")
-        return self._move(vm, proc, "IDRIVE", 1, lambda a: 1, run, self.jspeed, "JSPEED")
+        return self._move(vm, proc, "IDRIVE", [JOINTS], lambda a: 1, run, self.jspeed, "JSPEED")
 
     # === ED1A–ED1D: approach accuracy, completion ================================================
     def sacc(self, vm: VM, proc: Process) -> None:
@@ -894,7 +890,7 @@ class RobotHost(Host):
             if count != 1:
                 raise Flag(FLAG_INVALID, f"the gripper takes 1 parameter (opening, mm), "
                                          f"not {count}")
-            opening = float(_number(params[0]).value)
+            opening = float(params[0].value)
             if not 0.0 <= opening <= self.max_opening:
                 raise Flag(FLAG_INVALID, f"opening {opening:g} mm is outside "
                                          f"[0, {self.max_opening:g}] mm")
@@ -902,9 +898,8 @@ class RobotHost(Host):
         if count < 0:
             proc.pop()
             return self._flag(proc, "GRASP", Flag(FLAG_INVALID, f"parameter count {count}"))
-        if count + 1 > len(proc.stack):
-            raise fail(K.STACK_UNDERFLOW, f"{count} parameters wanted")
-        return self._move(vm, proc, "GRASP", count + 1, lambda a: 1, run, 1.0, "")
+        kinds = [NUMBER] * (min(count, len(proc.stack)) + 1)   # past the stack: underflow
+        return self._move(vm, proc, "GRASP", kinds, lambda a: 1, run, 1.0, "")
 
     def handdef(self, vm: VM, proc: Process) -> None:
         """a1 … an n b: hand b; parameters (all optional, in this order): the tool frame (Trn,
@@ -979,10 +974,27 @@ def _number(item: object) -> Num:
     return item
 
 
-def _pose(item: object) -> Pose:
-    if not isinstance(item, Pose):
-        raise fail(K.TYPE_MISMATCH, "a pose (Pm) expected")
-    return item
+# the types of a motion command's arguments: a test and what the error message calls it
+ArgKind = tuple[Callable[[object], bool], str]
+NUMBER: ArgKind = (lambda v: isinstance(v, Num), "a number")
+A_POSE: ArgKind = (lambda v: isinstance(v, Pose), "a pose (Pm)")
+POSES: ArgKind = (lambda v: isinstance(v, Pose) or isinstance(v, Array) and v.element.tag == POSE,
+                  "a pose (Pm) or a pose sequence (Ar of Pm)")
+JOINTS: ArgKind = (lambda v: isinstance(v, Array) and v.element.tag in NUMERIC_TAGS,
+                   "an array of numbers (the joint values)")
+
+
+def _arguments(proc: Process, kinds: list[ArgKind]) -> list:
+    """A command's arguments (deepest first), left on the stack: taken from the top down and
+    checked as taken, so that a wrong type is the exception (Annex 1 §9) before any flag
+    (the arm not ready was flag 4 for a string given as a pose)."""
+    args = []
+    for depth, (fits, what) in enumerate(reversed(kinds)):
+        item = proc.peek(depth)
+        if not fits(item):
+            raise fail(K.TYPE_MISMATCH, f"{what} expected, got {type_name(item)}")
+        args.append(item)
+    return args[::-1]
 
 
 FUNCTIONS: dict[str, Handler] = {

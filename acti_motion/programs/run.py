@@ -205,8 +205,9 @@ class ProgramRun:
         if main is not None:
             frame = main.frame
             codes = frame.codes
-            out.program_counter = (frame.origin + codes[frame.pc][2] if frame.pc < len(codes)
-                                   else frame.origin + (codes[-1][2] + codes[-1][3] if codes else 0))
+            offset = (codes[frame.pc][2] if frame.pc < len(codes)
+                      else codes[-1][2] + codes[-1][3] if codes else 0)
+            out.program_counter = vm.program_offset(main, frame, offset)
             if host.state == "running" and main.state is State.WAITING:
                 out.state = "waiting"
         out.motion_id, out.motion_label, out.progress, out.queue_length = self.arm.motion_status()

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ..codes import I2, Num, user_key
+from ..codes import I2, I4, INT_RANGE, Num, user_key
 from ..errors import ExceptionKind as K, fail
 from ..process import CYCLE_WAIT, RETRY, WAIT, Process, State
 from ..values import ENTRY_BYTES
@@ -24,19 +24,23 @@ def _state(proc: Process | None) -> Num:
 
 
 def _process(vm, number: int) -> Process | None:
-    return vm.processes.get(number)
+    """The process FXQT started under ``number``: process numbers are positive (EF76), so the
+    program itself (kept as 0) is none of them and cannot be killed, suspended or restarted."""
+    return vm.processes.get(number) if number > 0 else None
 
 
 # ---- processes ----------------------------------------------------------------------------------
 def fxqt(vm: VM, proc: Process) -> None:
-    """FXQT #a b: 0 started, −1 a is not a function, −2 number not usable (≤ 0 or busy)."""
+    """FXQT #a b: 0 started, −1 a is not a function, −2 number not usable (≤ 0, beyond I4,
+    or busy)."""
     number = pop_count(proc)
     target = function_of(proc, proc.pop())
     if target is None:
         proc.push(Num(I2, -1))
         return
     running = _process(vm, number)
-    if number <= 0 or (running is not None and running.state is not State.DONE):
+    busy = running is not None and running.state is not State.DONE
+    if busy or not 0 < number <= INT_RANGE[I4][1]:
         proc.push(Num(I2, -2))
         return
     frame = vm.function_frame(target, f"process {number}")
@@ -45,9 +49,17 @@ def fxqt(vm: VM, proc: Process) -> None:
     proc.push(Num(I2, 0))
 
 
+def _pop_at_least(proc: Process, lowest: int, what: str) -> int:
+    """A process setting the standard gives a range (EF78 priority ≥ 1, EF7A period ≥ 0)."""
+    value = pop_count(proc)
+    if value < lowest:
+        raise fail(K.UNDEFINED_DATA, f"{what} {value} (at least {lowest})")
+    return value
+
+
 def fprecd(vm: VM, proc: Process) -> None:
     """FPRECD a b: priority b (smaller runs first) for process a; the result is its state."""
-    priority = pop_count(proc)
+    priority = _pop_at_least(proc, 1, "priority")
     target = _process(vm, pop_count(proc))
     if target is not None:
         target.priority = priority
@@ -57,10 +69,10 @@ def fprecd(vm: VM, proc: Process) -> None:
 def fcycle(vm: VM, proc: Process) -> None:
     """FCYCLE a b: process a restarts every b ms (measured from its starts; a period that
     passes while it still runs is skipped); 0 ends the cyclic start."""
-    period = pop_count(proc)
+    period = _pop_at_least(proc, 0, "cyclic-start period (ms)")
     target = _process(vm, pop_count(proc))
     if target is not None:
-        target.period = max(period, 0) / 1000.0
+        target.period = period / 1000.0
         target.next_start = vm.host.now()
     proc.push(_state(target))
 
@@ -143,11 +155,26 @@ def _flag_on(vm: VM, number: int) -> None:
         vm.flags.add(number)
 
 
+def _flags_off(vm: VM, numbers) -> None:
+    """Flags off. A channel is full while its flag is on (choice 37): one turned off by other
+    means than CHIN (ECLR, UNLOCK, an EWAIT) is empty, its datum dropped, so that a later
+    ESIG does not bring the cleared datum back."""
+    for number in numbers:
+        vm.flags.discard(number)
+        vm.channels.pop(number, None)
+    vm.changed()
+
+
+MAX_FLAG = 32767    # EPOP gives a flag number as I2 (EF89)
+
+
 def flag_number(item) -> int:
-    """Event-flag and channel numbers are positive (EPOP uses 0 for 'no event')."""
+    """Event-flag and channel numbers are positive (EPOP uses 0 for 'no event') and fit the
+    I2 that EPOP pushes."""
     number = integer_value(expect(item, Num, "an event-flag number"))
-    if number <= 0:
-        raise fail(K.UNDEFINED_DATA, f"event flag {number} does not exist")
+    if not 0 < number <= MAX_FLAG:
+        raise fail(K.UNDEFINED_DATA, f"event flag {number:.6g} does not exist (flags are "
+                                     f"1 … {MAX_FLAG}: EPOP gives them as I2)")
     return number
 
 
@@ -179,8 +206,7 @@ def unlock(vm: VM, proc: Process) -> None:
     if number not in vm.flags:
         proc.push(Num(I2, 1))
         return
-    vm.flags.discard(number)
-    vm.changed()
+    _flags_off(vm, [number])
     proc.push(Num(I2, 0))
 
 
@@ -189,8 +215,7 @@ def ewait(vm: VM, proc: Process):
     if number not in vm.flags:
         return WAIT
     proc.pop()
-    vm.flags.discard(number)
-    vm.changed()
+    _flags_off(vm, [number])
     return None
 
 
@@ -200,8 +225,7 @@ def ewaita(vm: VM, proc: Process):
     if not vm.flags.issuperset(numbers):
         return WAIT
     _take_flags(proc, len(numbers))
-    vm.flags.difference_update(numbers)
-    vm.changed()
+    _flags_off(vm, numbers)
     return None
 
 
@@ -215,8 +239,7 @@ def ewaito(vm: VM, proc: Process):
         return WAIT
     _take_flags(proc, len(numbers))
     proc.event_buffer.extend(occurred)
-    vm.flags.difference_update(occurred)
-    vm.changed()
+    _flags_off(vm, occurred)
     return None
 
 
@@ -234,10 +257,7 @@ def eclr(vm: VM, proc: Process) -> None:
     """ECLR a1 … an n: those flags off; n = 0 turns every flag off."""
     count = pop_count(proc)
     numbers = [flag_number(item) for item in pop_many(proc, count)]
-    if count == 0:
-        vm.flags.clear()
-    vm.flags.difference_update(numbers)
-    vm.changed()
+    _flags_off(vm, list(vm.flags) if count == 0 else numbers)
 
 
 # ---- channels -----------------------------------------------------------------------------------

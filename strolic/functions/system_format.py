@@ -8,9 +8,9 @@ from __future__ import annotations
 import re
 from typing import TYPE_CHECKING
 
-from ..codes import (ARRAY, I2, NUMERIC_TAGS, POSE, R4, R8, RECORD, STRING, TAG_NAMES, TRANSFORM,
-                     VECTOR, Array, Num, Pose, Record, Str, TagHead, Trn, UserCode, Vec,
-                     make_number, round_half_away, type_name, user_key)
+from ..codes import (ARRAY, I2, INT_RANGE, NUMERIC_TAGS, POSE, R4, R8, RECORD, STRING, TAG_NAMES,
+                     TRANSFORM, VECTOR, Array, Function, Num, Pose, Record, Str, TagHead, Trn,
+                     UserCode, Vec, make_number, round_half_away, type_name, user_key)
 from ..errors import ExceptionKind as K, StrolicError, fail
 from ..formatting import assignments, basic_encode, c_decode, c_encode, conversion_error
 from ..literals import format_head
@@ -38,7 +38,8 @@ def text_datum(text: bytes):
     except (StrolicError, UnicodeDecodeError):
         return None
     if len(codes) == 1 and codes[0].kind is CodeKind.DATA:
-        return codes[0].value
+        value = codes[0].value      # a function read from text has no place in the program
+        return Function(value.body) if isinstance(value, Function) else value
     return None
 
 
@@ -149,9 +150,13 @@ def decode2(vm: VM, proc: Process) -> None:
                for item in pop_many(proc, pop_count(proc))]
     data = pop_of(proc, Str, "a string").data
     template = pop_of(proc, Str, "a format string").data
-    if assignments(template) > len(targets):
-        raise conversion_error(f"the format stores {assignments(template)} values, "
+    stored = assignments(template)
+    if stored > len(targets):
+        raise conversion_error(f"the format stores {stored} values, "
                                f"{len(targets)} user codes are given")
+    if stored > INT_RANGE[I2][1]:
+        raise conversion_error(f"the format stores {stored} values; the count is an I2 "
+                               f"(at most {INT_RANGE[I2][1]})")
     values, count = c_decode(template, data)
     for target, value in zip(targets, values):
         find(proc.scopes, user_key(target.code)).assign(value)

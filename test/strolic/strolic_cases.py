@@ -308,11 +308,17 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
     "FXQT": [("#f Fn{ 1 ESIG END } STORE #f 1 FXQT 1 EWAIT 1 FDONE", [F, F]),
              ("#x 5 STORE #x 1 FXQT", ["I2:-1"]), ("#f Fn{ END } STORE #f 0 FXQT", ["I2:-2"]),
              (f"{FN_WAIT} #f 1 FXQT #f 1 FXQT", [F, "I2:-2"]),
-             ("#f Fn{ END } STORE #f PUSH 2 FXQT", [F])],
-    "FPREDC": [(f"{FN_WAIT} #f 1 FXQT 1 5 FPREDC", [F, T]), ("9 5 FPREDC", [F])],
+             ("#f Fn{ END } STORE #f PUSH 2 FXQT", [F]),
+             # a process number is an integer of STROLIC (at most an I4), as a file number is
+             ("#f Fn{ END } STORE #f 1e300 FXQT", ["I2:-2"])],
+    # EF78: "the priority b is a positive integer" (−5 ran the process before all others)
+    "FPREDC": [(f"{FN_WAIT} #f 1 FXQT 1 5 FPREDC", [F, T]), ("9 5 FPREDC", [F]),
+               (f"{FN_WAIT} #f 1 FXQT 1 -5 FPREDC", UNDEF), ("9 0 FPREDC", UNDEF)],
     "FCYCLE": [("#x 0 STORE #f Fn{ #x x INC STORE END } STORE #f 1 FXQT DROP 1 5 FCYCLE DROP "
                 "#g Fn{ top: x 3 LT >top BRT END } STORE g 1 0 FCYCLE x 3 GEQ",
-                ["I2:2", T]), ("9 10 FCYCLE", [F])],
+                ["I2:2", T]), ("9 10 FCYCLE", [F]),
+               # EF7A: the period is a positive integer, 0 none (−10 stopped the cycle as 0)
+               ("9 -10 FCYCLE", UNDEF)],
     "FDONE": [(f"{FN_WAIT} #f 1 FXQT 1 FDONE", [F, T]), ("7 FDONE", [F])],
     "FKILL": [(f"{FN_WAIT} #f 1 FXQT DROP 1 FKILL 1 FDONE 1 FKILL", [F, F, T])],
     "FSUSPEND": [(f"{FN_WAIT} #f 1 FXQT DROP 1 FSUSPEND 1 FDONE 1 FSUSPEND", [F, "I2:3", T]),
@@ -340,10 +346,16 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
     "EWAITO": [("2 ESIG 1 2 2 EWAITO EPOP EPOP", ["I2:2", F]),
                ("1 ESIG 3 ESIG 1 2 3 3 EWAITO EPOP EPOP EPOP", [T, "I2:3", F]),
                ("1 2 2 EWAITO", DEAD)],
-    "EPOP": [("EPOP", [F])],
-    "ESIG": [("1 ESIG 1 EWAIT 7", ["7"]), ("-1 ESIG", UNDEF), ("1.4 ESIG 1 EWAIT 7", ["7"])],
+    # EPOP gives a flag number as I2 (EF89), so flag numbers end at 32767: a flag 70000 came
+    # back as an I2 that no I2 holds (RESULT of it stopped with a Python error)
+    "EPOP": [("EPOP", [F]), ("I2:32767 ESIG I2:32767 1 EWAITO EPOP", ["32767"])],
+    "ESIG": [("1 ESIG 1 EWAIT 7", ["7"]), ("-1 ESIG", UNDEF), ("1.4 ESIG 1 EWAIT 7", ["7"]),
+             ("I4:32768 ESIG", UNDEF), ("1e300 ESIG", UNDEF)],
     "ECLR": [("1 ESIG 2 ESIG 1 1 ECLR 2 EWAIT 1 EWAIT", DEAD), ("1 ESIG 0 ECLR 1 EWAIT", DEAD),
-             ("1 ESIG 2 ESIG 0 ECLR 3", ["3"]), ("1 ESIG 1 1 ECLR 1 ESIG 1 EWAIT 4", ["4"])],
+             ("1 ESIG 2 ESIG 0 ECLR 3", ["3"]), ("1 ESIG 1 1 ECLR 1 ESIG 1 EWAIT 4", ["4"]),
+             # a channel cleared is empty: ESIG then CHIN found the cleared datum again
+             ("1 5 CHOUT 0 ECLR 1 ESIG 1 CHIN", UNDEF), ("1 5 CHOUT 1 1 ECLR 1 ESIG 1 CHIN", UNDEF),
+             ("1 5 CHOUT 1 UNLOCK DROP 1 ESIG 1 CHIN", UNDEF)],
     "CHIN": [('1 "hi" CHOUT 1 CHIN', ['"hi"']), ("1 CHIN", DEAD), ("1 ESIG 1 CHIN", UNDEF),
              ("#f Fn{ 1 1 CHOUT 1 2 CHOUT 1 3 CHOUT END } STORE #f 1 FXQT DROP "
               "1 CHIN 1 CHIN 1 CHIN", ["1", "2", "3"])],

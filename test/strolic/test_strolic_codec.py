@@ -204,6 +204,14 @@ def test_assembler_rejects_bad_text(text: str) -> None:
         assemble(text)
 
 
+def test_a_label_defined_twice_in_one_body_is_refused() -> None:
+    """A branch to a label written twice went silently to the second one (the text form's
+    labels name one place in a function body)."""
+    with pytest.raises(StrolicError, match="label 'a' is defined twice"):
+        assemble("Fn{ >a BRA a: 1 a: END }")
+    assert assemble("Fn{ a: END } Fn{ a: END }")       # each body has its own labels
+
+
 # ---- hypothesis: generated programs round-trip; random bytes only raise StrolicError -------------
 def numbers():
     return st.one_of(

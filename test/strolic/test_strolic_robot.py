@@ -18,6 +18,7 @@ from sim_fixtures import executor  # noqa: F401
 from strolic.codes import I2, Num, Str
 from strolic.errors import ExceptionKind as K
 from strolic.literals import format_value
+from strolic.text import assemble
 from strolic.values import encode_value
 from strolic_robot_cases import CASES, WORK, Check, numbers
 
@@ -168,6 +169,24 @@ def test_progress_while_paused_counts_the_instructions_run(arm, executor):  # no
     assert program.run().status is Status.FINISHED
     assert seen and {p.state for p in seen} == {"paused"}
     assert {p.instructions for p in seen} == {7}                # 1 2 3 DROP×3 "hold": PAUSE runs
+
+
+def test_progress_inside_a_function_made_at_run_time_shows_where_it_was_called(
+        arm, executor):  # noqa: F811
+    """A function made at run time (DECODE1) has no bytes in the program: the progress added
+    its missing origin to an offset (a TypeError in every feedback while the program ran it);
+    the program counter is now the code that called it."""
+    text = '.name g %1000 VAR #g DCL #g "Fn{ 0.2 DELAY END }" #Fn(0) DECODE1 STORE g'
+    program = ProgramRun(arm, text, step=None)
+    seen = []
+
+    def step():
+        executor.step()
+        seen.append(program.progress().program_counter)
+    program.host.step = step
+    assert program.run().status is Status.FINISHED
+    code = assemble(text)
+    assert code[seen[-1]:] == bytes.fromhex("1000")          # the last code: g
 
 
 def test_a_long_pause_message_is_shown_cut(arm, executor):  # noqa: F811

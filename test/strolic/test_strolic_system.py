@@ -227,3 +227,16 @@ def test_a_file_that_fails_to_close_at_the_end_is_reported() -> None:
 
     error = error_of('1 2 FOPEN 1 "x" OUTPUT', host=DiskFull())
     assert error.kind is ExceptionKind.FILE_ERROR and "No space left" in error.detail
+
+
+@pytest.mark.parametrize("count, expected", [(32767, ["32767"]), (32768, None)])
+def test_decode2_stores_at_most_what_its_i2_count_can_say(count: int, expected) -> None:
+    """EE21 DECODE2 pushes the number of values stored as I2: a format of 32768 conversions
+    pushed an I2 no I2 holds, and RESULT of it stopped with a Python struct error. It is a
+    conversion error now, found before anything is stored."""
+    program = (f'"{"%d" * count}" "{"1 " * count}" {"#x " * count} I4:{count} DECODE2 DUP '
+               "RESULT")
+    if expected is None:
+        assert error_of(program, budget=None).kind is ExceptionKind.CONVERSION_ERROR
+    else:
+        assert stack_of(program, budget=None) == expected

@@ -293,3 +293,54 @@ def test_registrations_flags_and_channel_data_count_as_data_held(step: str) -> N
     program = (f'.name s %1005 .name y %1006 .name n %1007 VAR #s #n DCL #s "{"A" * 1000}" STORE '
                f"#n I4:1 STORE #f Fn{{ top: {step} >top BRA END }} STORE f")
     assert error_of(program, budget=None, memory_limit=1_000_000).kind is K.MEMORY_EXHAUSTED
+
+
+@pytest.mark.parametrize("program, code", [
+    ("#x Rd<7ff0000000000000> STORE #x 0 #R8 EXTB", "EF54"),   # EXTB: the bytes are no R8
+    ("#x 1.0 STORE #x 0 Rd<7ff0000000000000> EMBB x", "1000"),  # x read after the write
+    ("#x Ar[R8 1.0] STORE #x 0 Rd<7ff0000000000000> EMBB #x 0 EXTE", "EF56"),
+])
+def test_data_that_is_no_number_at_run_time_is_reported_where_it_is_read(program: str,
+                                                                         code: str) -> None:
+    """§4.5: the report names the code where the program stopped. Bytes read as a real at run
+    time (EXTB, EXTE, a variable rebuilt after EMBB) that are no number (Reference 2: no NaN,
+    no ∞) were reported at byte 0, the offset inside the datum, not in the program."""
+    program_bytes = assemble(PRELUDE + program)
+    with pytest.raises(StrolicError) as caught:
+        VM(RecordingHost()).run(program_bytes)
+    assert caught.value.kind is K.INVALID_CODE
+    offset = caught.value.offset
+    assert program_bytes[offset:offset + 2] == bytes.fromhex(code), caught.value.report()
+
+
+@pytest.mark.parametrize("program, expected", [
+    ("0 FKILL 5", ["I2:1", "5"]),                   # 1: process 0 is not executing
+    ("#f Fn{ 0 FKILL END } STORE #f 1 FXQT DROP 2 1 1 5 IOWAIT DROP DROP 5", ["5"]),
+    ("0 FSUSPEND 5", ["I2:1", "5"]),
+    ("#f Fn{ 0 FSUSPEND END } STORE #f 1 FXQT DROP 2 1 1 5 IOWAIT DROP DROP 5", ["5"]),
+    ("0 FRESUME", ["I2:1"]), ("0 FDONE", ["I2:0"]), ("0 5 FPRECD", ["I2:0"]),
+    ("0 10 FCYCLE", ["I2:0"]),
+])
+def test_the_program_is_no_process_number(program: str, expected: list[str]) -> None:
+    """EF76 FXQT: process numbers are positive integers (0 and below are refused, −2). The
+    program itself has none: FKILL 0 ended the program as if it had ended normally (its
+    stack kept, the rest not run), FSUSPEND 0 made every process wait (deadlock), FCYCLE 0
+    restarted the program. Functions EF78–EF82 treat 0 as a number no process has."""
+    assert stack_of(program) == expected
+
+
+@pytest.mark.parametrize("program", [
+    '#g "Fn{ 1 0 DIV END }" #Fn(0) DECODE1 STORE 1 2 g',             # a body read from text
+    "2 #Fn(0) #g ALLOC DROP g",                       # an Fn area of zero bytes: invalid code
+    '#f Fn{ 7 g END } STORE #g "Fn{ 1 0 DIV END }" #Fn(0) DECODE1 STORE f',   # called by f
+])
+def test_an_exception_in_a_function_made_at_run_time_is_located_where_it_was_called(
+        program: str) -> None:
+    """§4.5: the report names the code where the program stopped. A function made at run
+    time (DECODE1, an Fn area) has no bytes in the program; its offsets inside its own body
+    (and those of the throwaway text DECODE1 read) were reported as program offsets."""
+    program_bytes = assemble(PRELUDE + program)
+    with pytest.raises(StrolicError) as caught:
+        VM(RecordingHost()).run(program_bytes)
+    offset = caught.value.offset
+    assert program_bytes[offset:offset + 2] == bytes.fromhex("1003"), caught.value.report()
