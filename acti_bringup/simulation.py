@@ -128,7 +128,7 @@ class Simulation:
         self.executor.start(prepare=self._schedule_control_loop)
         planes.start()
         try:
-            wait_for_signal(planes.serving)
+            wait_for_signal(lambda: planes.serving() and not self.executor.failed)
         finally:
             end_goals(helpers)
             self.executor.shutdown()
@@ -139,6 +139,8 @@ class Simulation:
             rclpy.try_shutdown()
         for error in planes.errors():
             raise error
+        if self.executor.failed:
+            raise self.executor.error
 
 
 def run_alone(node_class: type, args: list[str] | None = None) -> None:

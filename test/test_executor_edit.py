@@ -1,12 +1,15 @@
 """The executor without ROS: Device.edit and Device.halt (in-place changes keep the queued end
 right; a halt discards everything at once and rests where it is told), sequences queued whole,
-what was discarded, and step listeners at their rates."""
+what was discarded, step listeners at their rates, and a step that fails."""
+import random
+import time
 from dataclasses import dataclass
 
 import numpy as np
 
 from acti_motion.executor import Device, DiscardLog, MotionExecutor
 from acti_sim.world import World
+from sim_fixtures import executor  # noqa: F401
 
 
 @dataclass
@@ -114,3 +117,37 @@ def test_a_listener_keeps_a_rate_that_is_no_whole_number_of_steps():
     fractional = np.array([c for c in calls if c > 0])
     assert len(fractional) == 100 and set(np.diff(fractional).tolist()) == {2, 3}
     assert [-c for c in calls if c < 0] == list(range(5, 251, 5))
+
+
+def test_the_discard_log_marks_exactly_the_ranges_it_is_given():
+    """Ranges of every length and alignment (whole bytes are set at once) against a plain set."""
+    rng = random.Random(7)
+    log, expected, next_id = DiscardLog(), set(), 1
+    for _ in range(300):
+        first = next_id + rng.randrange(0, 20)
+        last = first + rng.choice([0, 1, 6, 7, 8, 9, 15, 16, 17, rng.randrange(0, 3000)])
+        log.add(first, last, "stop")
+        expected.update(range(first, last + 1))
+        next_id = last + 1
+    assert {i for i in range(next_id + 50) if log.reason(i) is not None} == expected
+
+
+def test_a_step_that_fails_ends_the_loop_and_says_so(executor, caplog):  # noqa: F811
+    """A bug in a step (here a listener) ends the loop with `failed` and the error, so that the
+    host ends too instead of answering calls while nothing moves."""
+    steps = []
+
+    def listener(_world) -> None:
+        steps.append(1)
+        if len(steps) == 5:
+            raise ZeroDivisionError("a listener's bug")
+    executor.after_step(listener)
+    executor.start()
+    deadline = time.monotonic() + 10.0
+    while not executor.failed and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert executor.failed and isinstance(executor.error, ZeroDivisionError)
+    executor._thread.join(timeout=5.0)
+    assert not executor._thread.is_alive() and len(steps) == 5
+    assert "the control loop stopped: ZeroDivisionError: a listener's bug" in caplog.text
+    executor.shutdown()
