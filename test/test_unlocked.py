@@ -14,9 +14,10 @@ import pytest
 from acti_msgs.msg import LimitValue
 from acti_msgs.srv import GetSoftLimitJoint
 from std_msgs.msg import Float64MultiArray, String
+from std_srvs.srv import Trigger
 
 from acti_bringup.serving.outbox import Outbox, unlocked_publish
-from acti_bringup.serving.responses import UnlockedSender
+from acti_bringup.serving.responses import LateResponses, UnlockedSender
 from acti_bringup.serving.unlocked import header_address, rcl
 from ros_harness import wait_until
 
@@ -101,6 +102,30 @@ def test_responses_reach_the_client_through_rcl(ros, events_loop):
         assert [(x.lower, x.upper) for x in r.soft_limit] == [(-1.5 - i, 2.5 + i) for i in range(7)]
         assert r.return_id.comment == "ok"
     assert len(headers) == 20 and None not in headers       # never rclpy's send
+    outbox.stop()
+
+
+def test_a_client_answered_once_is_answered_from_the_serving_thread(ros, events_loop):
+    """The first response to a client leaves from the outbox (DDS may hold it while it meets
+    the client), the next ones at once from the serving thread (no hand-over to pay)."""
+    node, loop = events_loop
+    threads: list[str] = []
+
+    class Recording(UnlockedSender):
+        def prepare(self, response, header):
+            prepared = super().prepare(response, header)
+
+            def send() -> bool:
+                threads.append(threading.current_thread().name)
+                return prepared.send()
+            return prepared._replace(send=send)
+    node.create_service(Trigger, "~/ping", lambda _q, response: response)
+    outbox = Outbox(print)
+    LateResponses(print, outbox, Recording).serve([node])
+    loop.start()
+    for _ in range(5):
+        ros.call(Trigger, "/spin_loop_test/ping")
+    assert threads == ["dds-out"] + ["test-events"] * 4
     outbox.stop()
 
 
