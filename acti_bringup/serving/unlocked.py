@@ -129,12 +129,14 @@ class MessageKind:
         return pointer
 
 
-def request_id(header: Any) -> ctypes.Array | None:
-    """A copy of the C rmw_request_id_t behind rclpy's header (rclpy's may not outlive the
-    request's callback), when it checks out."""
-    address = header_address(header)
-    return None if address is None else ctypes.create_string_buffer(
-        ctypes.string_at(address, _REQUEST_ID_SIZE), _REQUEST_ID_SIZE)
+GUID_BYTES = 16             # rmw_request_id_t.writer_guid: the client's request writer
+
+
+def request_id(address: int) -> ctypes.Array:
+    """A copy of the C rmw_request_id_t at `address` (`header_address`): rclpy's may not
+    outlive the request's callback."""
+    return ctypes.create_string_buffer(ctypes.string_at(address, _REQUEST_ID_SIZE),
+                                       _REQUEST_ID_SIZE)
 
 
 def header_address(header: Any) -> int | None:
