@@ -94,7 +94,8 @@ class Simulation:
         self.executor.after_step(listened, every=self.executor.steps_per_period(rate_hz))
 
     def _schedule_control_loop(self) -> None:
-        """On the simulation thread: real-time scheduling when the simulation keeps time."""
+        """On the simulation thread (and the outbox's, which sends the loop's messages):
+        real-time scheduling when the simulation keeps time."""
         priority = self.config.control_fifo_priority
         if priority and self.config.real_time_factor == 0:
             self._log.info("control_fifo_priority not applied: real_time_factor 0 runs the "
@@ -126,6 +127,7 @@ class Simulation:
             planes.add(helper.plane, [helper])
         freeze_heap()
         self.executor.start(prepare=self._schedule_control_loop)
+        planes.outbox.put(self._schedule_control_loop)       # it carries the loop's messages
         planes.start()
         try:
             wait_for_signal(lambda: planes.serving() and not self.executor.failed)

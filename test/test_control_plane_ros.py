@@ -19,7 +19,7 @@ from action_msgs.msg import GoalStatus
 from rosgraph_msgs.msg import Clock
 
 from acti_bringup.harness import FELL_BEHIND, OneShotClients
-from ros_harness import Actions, node_fixture, wait_until
+from ros_harness import Actions, NodeProcess, node_fixture, wait_until
 
 ARM_GOALS, BASE_GOALS = 3, 2
 job = node_fixture("acti_bringup", f"max_action_goals:={ARM_GOALS}",
@@ -100,13 +100,21 @@ def timed(fn: Callable[[], Any]) -> tuple[Any, float]:
     return out, time.monotonic() - t0
 
 
+def stat(path: str) -> list[str]:
+    """/proc/…/stat from field 3 (state) on."""
+    with open(f"{path}/stat") as f:
+        return f.read().rsplit(")", 1)[1].split()
+
+
+def rt_priorities(pid: int) -> list[int]:
+    """The real-time priority of every thread of process `pid` (0: ordinary scheduling)."""
+    tasks = f"/proc/{pid}/task"
+    return [int(stat(f"{tasks}/{tid}")[37]) for tid in os.listdir(tasks)]
+
+
 @pytest.mark.skipif(os.geteuid() != 0, reason="lowering the niceness needs root")
 def test_every_thread_of_the_job_runs_above_the_clients(ros, job):
     ros.call(srv.GetState, ARM + "get_state")            # the job serves
-
-    def stat(path: str) -> list[str]:
-        with open(f"{path}/stat") as f:
-            return f.read().rsplit(")", 1)[1].split()      # from field 3 (state) on
 
     def nice(path: str) -> int:
         return int(stat(path)[16])
@@ -114,7 +122,22 @@ def test_every_thread_of_the_job_runs_above_the_clients(ros, job):
     assert {nice(f"{tasks}/{tid}") for tid in os.listdir(tasks)} == {-10}
     assert nice(f"/proc/{os.getpid()}") == 0
     # real-time scheduling is opt-in (control_fifo_priority): by default no thread has it
-    assert {stat(f"{tasks}/{tid}")[38] for tid in os.listdir(tasks)} == {"0"}
+    assert set(rt_priorities(job.proc.pid)) == {0}
+    assert {stat(f"{tasks}/{tid}")[38] for tid in os.listdir(tasks)} == {"0"}    # SCHED_OTHER
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="real-time scheduling needs root")
+def test_real_time_scheduling_takes_the_control_loop_and_the_outbox_that_sends_its_messages(
+        ros, tmp_path):
+    node = NodeProcess("acti_middle_node", str(tmp_path / "node.log"),
+                       "control_fifo_priority:=10")
+    try:
+        assert wait_until(lambda: "services under" in node.log(), 60.0), node.log()
+        ros.call(srv.GetState, ARM + "get_state")
+        assert wait_until(lambda: sorted(rt_priorities(node.proc.pid))[-2:] == [10, 10], 10.0)
+        assert sorted(rt_priorities(node.proc.pid))[-3:] == [0, 10, 10]
+    finally:
+        node.stop()
 
 
 def test_goals_beyond_the_bound_are_rejected_and_stop_is_answered_while_the_rest_wait(ros, job):
