@@ -7,13 +7,14 @@ rclpy turns the failure into a RuntimeWarning and the response is lost: the clie
 thread of its own, and the log says so once per service when it never could be. A response
 that cannot be sent at all is one log line: raised, it would end the executor's serving.
 
-A client's first responses are converted at once and leave through the process's outbox
-(`acti_bringup.serving.outbox`), sent without the GIL: DDS holds the first sends to a new client
-(100 ms while it discovers the client's reader, a third of a second at a starting participant's
-shared-memory port), and rclpy's send would hold every thread of the process meanwhile. Once a
-client has been answered, rclpy sends its responses on the serving thread, as fast as a bare
-node: through the outbox every call cost ~50 µs more, through ctypes ~80 µs (getters 1.4-1.6x
-the bare round trip instead of 1.1-1.2x)."""
+Every response is converted at once and sent without the GIL (`acti_bringup.serving.unlocked`):
+rclpy's own send keeps the GIL while Fast DDS holds a send (a third of a second at a starting
+participant's shared-memory port, also to a client answered before), and every thread of the
+process, the control loop with it, waited. A client's first responses leave through the
+process's outbox (`acti_bringup.serving.outbox`): DDS holds the first sends to a new client
+most often (it waits up to 100 ms to discover the client's reader), and they must not hold the
+serving thread. A client answered before is answered at once on the serving thread: through
+the outbox every call cost ~50 µs more; sent here, 4 µs more than rclpy's send."""
 from __future__ import annotations
 
 import ctypes
@@ -80,9 +81,10 @@ class RclpySender:
 
 
 class UnlockedSender:
-    """Prepares a new client's responses for rcl's send without the GIL (`unlocked`), converted
-    now; a client answered before (by its request writer's GUID) gets rclpy's send, now. Where
-    the header cannot be read or rcl is not found, rclpy's send (through the outbox)."""
+    """Prepares responses for rcl's send without the GIL (`unlocked`), converted now: to be sent
+    now (on the serving thread) to a client answered before (by its request writer's GUID),
+    through the outbox to a new one. Where the header cannot be read or rcl is not found,
+    rclpy's send (through the outbox)."""
 
     ANSWERED_KEPT = 4096
 
@@ -97,10 +99,11 @@ class UnlockedSender:
         address = header_address(header) if lib is not None else None
         if address is None:
             return self._rclpy.prepare(response, header)
-        client = ctypes.string_at(address, GUID_BYTES)
-        if client in self._answered:
-            return self._rclpy.prepare(response, header)._replace(now=True)
-        copied, message = request_id(address), CMessage(self._kind, response)
+        client, message = ctypes.string_at(address, GUID_BYTES), CMessage(self._kind, response)
+        if client in self._answered:        # header and message live until it is sent, here
+            return Prepared(lambda: message.send(
+                self._handle, lambda s, m: lib.send_response(s, address, m)), message.discard, True)
+        copied = request_id(address)
 
         def send() -> bool:
             sent = message.send(self._handle, lambda s, m: lib.send_response(s, copied, m))
