@@ -9,9 +9,12 @@ import signal
 import time
 
 import pytest
+from acti_msgs.action import WaitMotion
 from acti_msgs.srv import GetState, VehicleGetState
+from rclpy.action import ActionServer
 from std_srvs.srv import Trigger
 
+from acti_bringup.serving.outbox import UnlockedActionHandle
 from acti_bringup.serving.spinning import SPIN_TIMEOUT_S, Planes
 from ros_harness import NodeProcess, wait_until
 
@@ -53,9 +56,11 @@ def test_the_planes_resend_what_dds_could_not_deliver_on_every_service_they_serv
         response.success = True
         return response
     node.create_service(Trigger, "~/ping", ping)
+    server = ActionServer(node, WaitMotion, "~/wait", lambda goal: WaitMotion.Result())
     planes = Planes()
     try:
         planes.add("control", [node])
+        assert isinstance(server._handle, UnlockedActionHandle)     # answers without the GIL
         senders = {s.service_name: s.send_response.__qualname__ for s in node.services}
         assert "/planes_test/ping" in senders and "/planes_test/list_parameters" in senders
         assert all(q.startswith("LateResponses._responder") for q in senders.values()), senders

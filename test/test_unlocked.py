@@ -186,5 +186,5 @@ def test_the_gil_is_free_while_rcl_sends():
         return during
     assert counted_during(ctypes.CDLL(None).usleep) > 10 * counted_during(ctypes.PyDLL(None).usleep)
     lib = rcl()
-    for send in (lib.send_response, lib.publish, lib.publish_feedback):
+    for send in (lib.send_response, lib.publish, lib.publish_feedback, *lib.action_answers.values()):
         assert not send._flags_ & ctypes._FUNCFLAG_PYTHONAPI

@@ -20,7 +20,7 @@ import threading
 from collections import deque
 from typing import Any, Callable
 
-from acti_bringup.serving.unlocked import CMessage, MessageKind, rcl
+from acti_bringup.serving.unlocked import CMessage, MessageKind, header_address, rcl, request_id
 
 Send = Callable[[], Any]
 Discard = Callable[[], None]
@@ -104,17 +104,21 @@ def unlocked_publish(outbox: Outbox, publisher: Any) -> Callable[[Any], None]:
     return publish
 
 
-class UnlockedFeedback:
-    """An rclpy ActionServer's handle whose feedback goes through the outbox (the goal, cancel
-    and result answers and the status stay rclpy's: they come once per goal, feedback at its
-    rate for every goal held)."""
+class UnlockedActionHandle:
+    """An rclpy ActionServer's handle whose feedback and answers (to goal, cancel and result
+    requests) go through the outbox without the GIL; its status stays rclpy's (rcl builds that
+    message from the goals it holds). A `ros2 action send_goal` is a starting participant, whose
+    first answers DDS holds most often."""
 
-    def __init__(self, handle: Any, feedback_type: type, outbox: Outbox) -> None:
+    def __init__(self, handle: Any, outbox: Outbox) -> None:
         self._handle, self._outbox = handle, outbox
-        self._kind = MessageKind(feedback_type)
+        self._kinds: dict[type, MessageKind] = {}
 
     def __getattr__(self, name: str) -> Any:
-        return getattr(self._handle, name)
+        send = rcl().action_answers.get(name)
+        if send is None:
+            return getattr(self._handle, name)
+        return lambda header, msg: self._answer(send, getattr(self._handle, name), header, msg)
 
     def __enter__(self) -> Any:
         return self._handle.__enter__()
@@ -122,13 +126,29 @@ class UnlockedFeedback:
     def __exit__(self, *exc: Any) -> Any:
         return self._handle.__exit__(*exc)
 
+    def _message(self, msg: Any) -> CMessage:
+        kind = self._kinds.get(type(msg)) or self._kinds.setdefault(type(msg), MessageKind(type(msg)))
+        return CMessage(kind, msg)
+
     def publish_feedback(self, msg: Any) -> None:
-        message, handle, publish = CMessage(self._kind, msg), self._handle, rcl().publish_feedback
+        message, handle, publish = self._message(msg), self._handle, rcl().publish_feedback
         self._outbox.put(lambda: message.send(handle, publish), message.discard)
 
+    def _answer(self, send: Any, rclpy_send: Callable[[Any, Any], None], header: Any,
+                msg: Any) -> None:
+        """send(server, request id, message) from the outbox; rclpy's send where the header
+        cannot be read."""
+        address = header_address(header)
+        if address is None:
+            self._outbox.put(lambda: rclpy_send(header, msg))
+            return
+        copied, message, handle = request_id(address), self._message(msg), self._handle
+        self._outbox.put(lambda: message.send(handle, lambda s, m: send(s, copied, m)),
+                         message.discard)
 
-def unlock_feedback(action_server: Any, outbox: Outbox) -> None:
-    """Send this ActionServer's feedback through the outbox (left to rclpy without rcl)."""
-    if rcl() is not None and not isinstance(action_server._handle, UnlockedFeedback):
-        action_server._handle = UnlockedFeedback(
-            action_server._handle, action_server.action_type.Impl.FeedbackMessage, outbox)
+
+def unlock_action(action_server: Any, outbox: Outbox) -> None:
+    """Send this ActionServer's feedback and answers through the outbox (left to rclpy
+    without rcl)."""
+    if rcl() is not None and not isinstance(action_server._handle, UnlockedActionHandle):
+        action_server._handle = UnlockedActionHandle(action_server._handle, outbox)

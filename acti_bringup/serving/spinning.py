@@ -9,9 +9,10 @@
 - The goal plane (the action servers) runs on a `SingleThreadedExecutor`: goals are coroutines
   that await (`acti_bringup.serving.waiting`), which the EventsExecutor would poll without pause.
 
-What the planes and the control loop send (responses, messages, action feedback) leaves through
-one outbox thread, without the GIL (`acti_bringup.serving.outbox`): a send that DDS holds back
-holds no plane and no control step.
+What the planes and the control loop send (messages, the actions' feedback and answers, a new
+client's responses) leaves through one outbox thread, without the GIL; a known client's response
+leaves at once, without the GIL too (`acti_bringup.serving.outbox`, `responses`): a send that DDS
+holds back holds no other thread and no control step.
 
 Each executor is driven by a `spin_once` loop (the EventsExecutor's `spin()` serves nothing in
 this rclpy and neither honours SIGINT); SIGINT and SIGTERM are handled here, on the main thread.
@@ -37,7 +38,7 @@ from rclpy.node import Node
 from rclpy.publisher import Publisher
 from rclpy.timer import Timer
 
-from acti_bringup.serving.outbox import Outbox, unlock_feedback, unlocked_publish
+from acti_bringup.serving.outbox import Outbox, unlock_action, unlocked_publish
 from acti_bringup.serving.responses import LateResponses
 
 RCLError = rclpy_implementation.RCLError
@@ -208,7 +209,7 @@ class Planes:
                 publisher.publish = unlocked_publish(self.outbox, publisher)
             for waitable in n.waitables:
                 if isinstance(waitable, ActionServer):
-                    unlock_feedback(waitable, self.outbox)
+                    unlock_action(waitable, self.outbox)
         self._late.serve(nodes)
 
     def start(self) -> None:

@@ -1,10 +1,11 @@
-"""Messages, responses and action feedback handed to rcl with the GIL released.
+"""Messages, responses and the actions' feedback and answers handed to rcl with the GIL released.
 
 rclpy publishes and responds inside one C call that holds the GIL throughout, and Fast DDS can
 hold such a call for a third of a second (`acti_bringup.serving.outbox` says when): every
 thread of the process then waits. Here a Python message is converted to its C message under the
 GIL (rosidl's own conversion, the one rclpy uses), and the send itself (`rcl_publish`,
-`rcl_send_response`, `rcl_action_publish_feedback`) is called through ctypes, which releases
+`rcl_send_response`, `rcl_action_publish_feedback`, `rcl_action_send_*_response`) is called
+through ctypes, which releases
 the GIL for the call.
 
 rclpy gives Python no access to a request header's writer GUID, which rcl needs. The header is
@@ -55,6 +56,11 @@ class Rcl:
         self.publish_feedback = action.rcl_action_publish_feedback
         self.publish_feedback.restype = ctypes.c_int
         self.publish_feedback.argtypes = (ctypes.c_void_p,) * 2
+        # an action server's answers, by the name of rclpy's method that sends them
+        self.action_answers = {f"send_{kind}_response": getattr(action, f"rcl_action_send_{kind}_response")
+                               for kind in ("goal", "cancel", "result")}
+        for fn in self.action_answers.values():
+            fn.restype, fn.argtypes = ctypes.c_int, (ctypes.c_void_p,) * 3
         self._rcutils.rcutils_get_error_string.restype = _ErrorString
         self._rcutils.rcutils_reset_error.restype = None
 
