@@ -5,7 +5,7 @@ import math
 import time
 
 import numpy as np
-from common import RosClient, against, bare_call, interleaved, running, simulated_arm, table
+from common import RosClient, bare_call, paired, running, simulated_arm, table
 
 from acti_msgs import srv
 from acti_msgs.msg import CarPosWithElbow
@@ -40,13 +40,14 @@ def accept_latency() -> None:
             r = ros.call(srv.MoveLinearCartesianRel, ARM + "move_linear_cartesian_rel",
                          car_point=CarPosWithElbow(car_pos=m))
             assert r.return_id.id == 0, r.return_id.comment
-        samples = interleaved(against(("bare Trigger", bare_call(ros)), [
+        pairs = paired(bare_call(ros), [
             ("get_state while moving", lambda: ros.call(srv.GetState, ARM + "get_state")),
             ("move_ptp_joint_rel accept", ptp),
-            ("move_linear_cartesian_rel (20 mm) accept", cp)]), N, warmup=10)
+            ("move_linear_cartesian_rel (20 mm) accept", cp)], N, warmup=10)
         moving = ros.call(srv.GetState, ARM + "get_state").state & 0x02
-    table(f"round trip over DDS, {N} rounds of (bare, call), arm moving: {bool(moving)} "
-          f"(real time; goals: PTP accept <= 1.5, CP accept <= 3)", samples, "bare Trigger")
+    table(f"round trip over DDS, {N} alternations (bare, call) for each call, arm moving: "
+          f"{bool(moving)} (real time; goals: PTP accept <= 1.5, CP accept <= 3)", pairs,
+          "bare Trigger")
     ros.close()
 
 

@@ -71,6 +71,22 @@ def against(baseline: tuple[str, Callable[[], object]], measured: Calls) -> Call
     return [c for m in measured for c in (baseline, m)]
 
 
+Pairs = dict[str, tuple[np.ndarray, np.ndarray]]
+
+
+def paired(baseline: Callable[[], object], measured: Calls, n: int, warmup: int = 30) -> Pairs:
+    """Each measured call in a block of its own, alternating with the baseline (A B A B …, then
+    A C A C …): name -> (the baseline's sample, the call's sample) of that block. Both calls of
+    a block are equally warm; in one round through many services (A B A C A D …) each service
+    is called once in 2k calls and the baseline every other call, which weighs the caches'
+    coldness (the client's as much as the server's) on the measured side only."""
+    out: Pairs = {}
+    for name, fn in measured:
+        block = interleaved([("baseline", baseline), (name, fn)], n, warmup)
+        out[name] = (block["baseline"], block[name])
+    return out
+
+
 def p(sample: np.ndarray, q: float) -> float:
     """The q-th percentile in ms."""
     return float(np.percentile(sample, q)) * 1e3
@@ -88,16 +104,16 @@ def row(name: str, sample: np.ndarray, baseline: np.ndarray | None = None) -> st
     return text
 
 
-def table(title: str, samples: dict[str, np.ndarray], baseline: str) -> None:
-    """Print the samples, each against the baseline sample taken interleaved with it."""
+def table(title: str, pairs: Pairs, baseline: str) -> None:
+    """Print each measured call against the baseline sample of its own block (and the baseline's
+    samples pooled)."""
     print(title)
     print(f"(bare baseline: std_srvs/Trigger on rclpy's {BARE_EXECUTOR} executor, the kind the "
-          f"nodes' control plane runs on; client waits with its own spin_once loop)")
-    base = samples[baseline]
-    print(row(baseline, base))
-    for name, sample in samples.items():
-        if name != baseline:
-            print(row(name, sample, base))
+          f"nodes' control plane runs on; client waits with its own spin_once loop; each call "
+          f"in its own block, alternating with the baseline)")
+    print(row(baseline, np.concatenate([base for base, _ in pairs.values()])))
+    for name, (base, sample) in pairs.items():
+        print(row(name, sample, base))
 
 
 def cpu_seconds(pid: int) -> float:
@@ -114,11 +130,10 @@ def idle_cpu_percent(pid: int, seconds: float = 5.0) -> float:
     return 100.0 * (cpu_seconds(pid) - c0) / (time.monotonic() - t0)
 
 
-def worst_ratios(samples: dict[str, np.ndarray], baseline: str) -> tuple[float, float]:
-    """The largest p50 and p99 ratio of any measured call to the baseline."""
-    base = samples[baseline]
-    rest = [s for name, s in samples.items() if name != baseline]
-    return (max(p(s, 50) for s in rest) / p(base, 50), max(p(s, 99) for s in rest) / p(base, 99))
+def worst_ratios(pairs: Pairs) -> tuple[float, float]:
+    """The largest p50 and p99 ratio of any measured call to its block's baseline."""
+    return (max(p(s, 50) / p(base, 50) for base, s in pairs.values()),
+            max(p(s, 99) / p(base, 99) for base, s in pairs.values()))
 
 
 def simulated_arm(initial_joints_deg: tuple[float, ...], speed: int):
