@@ -205,6 +205,9 @@ def test_joystick_over_the_joy_topic(ros, vehicle):
             joy.publish(Joy(axes=[0.0, 0.5], buttons=[]))
             ros.executor.spin_once(timeout_sec=0.05)
         assert ros.spin_until(lambda: any(m.state == 0x011 for m in got[-20:]), 2.0)
+        assert "joy has" not in vehicle.log()
+        joy.publish(Joy(axes=[0.5], buttons=[]))    # no axis 1: read as centred, and said once
+        assert wait_until(lambda: "joy has 1 axes, and joy_axis_linear 1" in vehicle.log(), 5.0)
         assert call(ros, "set_joystick", on_off=False).success
         assert ros.spin_until(lambda: got[-1].state == 0x010 and not got[-1].joystick, 5.0)
     finally:

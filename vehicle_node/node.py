@@ -116,6 +116,7 @@ class VehicleNode(Node):
         warn_of_namesakes(self, self._state)
         self._diagnostics = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self._cmd_vel_clamped = False
+        self._joy_axes_missing = False
         # commands that move the base arrive on the motion plane, like the move services
         self.motion.create_subscription(Twist, "cmd_vel", self._on_cmd_vel, 10)
         self.motion.create_subscription(Joy, "joy", self._on_joy, 10)
@@ -149,6 +150,13 @@ class VehicleNode(Node):
             self.get_logger().warn(f"cmd_vel refused: {reply.comment}", throttle_duration_sec=2.0)
 
     def _on_joy(self, msg: Joy) -> None:
+        c = self.core.config
+        if max(c.joy_axis_linear, c.joy_axis_angular) >= len(msg.axes) and not self._joy_axes_missing:
+            self._joy_axes_missing = True
+            self.get_logger().warn(
+                f"joy has {len(msg.axes)} axes, and joy_axis_linear {c.joy_axis_linear} or "
+                f"joy_axis_angular {c.joy_axis_angular} is not one of them: that axis reads as "
+                "centred (0); set the parameter to this joystick's axis (this is logged once)")
         self.core.joy_input(list(msg.axes), list(msg.buttons))
 
     # --- topics out (simulation thread) -------------------------------------------------------
