@@ -130,6 +130,20 @@ def test_goals_held_at_a_signal_end_aborted_and_their_clients_are_told(ros, tmp_
     assert "Traceback" not in node.log(), node.log()
 
 
+@pytest.mark.parametrize("domain", ["300", "-1", "seven"])
+def test_a_domain_dds_cannot_use_is_one_line_and_exit_status_2(tmp_path, monkeypatch, domain):
+    """Was: Fast DDS's own error ("Calculated port number is too high") and exit status 1."""
+    monkeypatch.setenv("ROS_DOMAIN_ID", domain)
+    node = NodeProcess("acti_bringup", str(tmp_path / "node.log"), "view_enabled:=false")
+    try:
+        assert node.proc.wait(timeout=60.0) == 2, node.log()
+    finally:
+        node.stop()
+    fatal = [line for line in node.log().splitlines() if "[FATAL]" in line]
+    assert len(fatal) == 1 and f"ROS_DOMAIN_ID={domain} is not a DDS domain: use 0 … 232" in fatal[0]
+    assert "Traceback" not in node.log() and "RTPS" not in node.log(), node.log()
+
+
 @pytest.mark.parametrize("module", ["acti_bringup", "vehicle_node"])
 def test_help_prints_the_usage_and_starts_nothing(tmp_path, module):
     """`python -m acti_bringup --help` started a robot (and its live view) without a word."""

@@ -64,16 +64,24 @@ USAGE_TAIL = ("ROS arguments: --ros-args -r __ns:=/robot1 -p name:=value "
               "--params-file config/acti_ros2.yaml (README.md: Parameters)")
 
 
+MAX_DOMAIN_ID = 232     # Fast DDS: 7400 + 250 × domain + offsets must stay a UDP port
+
+
 def init(args: list[str]) -> None:
     """rclpy.init with this module's signal handling instead of rclpy's. ROS arguments rcl
-    refuses (a remap it cannot parse, a parameters file it cannot read) end the process as a
-    refused setting does (`build_or_exit`). `-h`/`--help` prints the usage and exits: it
+    refuses (a remap it cannot parse, a parameters file it cannot read) and a ROS_DOMAIN_ID
+    DDS cannot use end the process as a refused setting does (`build_or_exit`). `-h`/`--help` prints the usage and exits: it
     started a robot, in whatever domain the shell had."""
     own = args[1:args.index("--ros-args")] if "--ros-args" in args else args[1:]
     if {"-h", "--help"} & set(own):
         print(f"{(sys.modules['__main__'].__doc__ or '').strip()}\n\n{USAGE_TAIL}")
         raise SystemExit(0)
     catch_signals()
+    domain = os.environ.get("ROS_DOMAIN_ID", "").strip()
+    if domain and not (domain.isdigit() and int(domain) <= MAX_DOMAIN_ID):
+        _cannot_start(_program_name(), f"ROS_DOMAIN_ID={domain} is not a DDS domain: use 0 … "
+                      f"{MAX_DOMAIN_ID} (DDS derives its UDP ports from it; 0 … 101 stay clear "
+                      "of Linux's ephemeral ports)")
     try:
         rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     except RCLError as e:
