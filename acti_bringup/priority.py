@@ -26,27 +26,21 @@ def thread_ids() -> list[int]:
     return [int(t) for t in os.listdir("/proc/self/task")]
 
 
-def _on_threads(apply: Callable[[int], None], tids: list[int]) -> bool:
-    """apply(tid) to these threads of this process (0: the calling one); False where it was
-    refused."""
-    refused = []
-    for tid in tids:
-        try:
-            apply(tid)
-        except ProcessLookupError:          # the thread ended meanwhile
-            continue
-        except PermissionError:
-            refused.append(tid)
-    return not refused
-
-
 def set_niceness(nice: int, log: Callable[[str], None]) -> bool:
     """Give every thread of this process (and so every thread it makes later: a thread starts
     with its creator's) the niceness `nice`; False, after one log line, where it is refused."""
     lo, hi = NICE_RANGE
     if not lo <= nice <= hi:
         raise ValueError(f"nice must be {lo} … {hi}, got {nice}")
-    if not _on_threads(lambda tid: os.setpriority(os.PRIO_PROCESS, tid, nice), thread_ids()):
+    refused = []
+    for tid in thread_ids():
+        try:
+            os.setpriority(os.PRIO_PROCESS, tid, nice)
+        except ProcessLookupError:          # the thread ended meanwhile
+            continue
+        except PermissionError:
+            refused.append(tid)
+    if refused:
         log(f"nice {nice} refused (it needs CAP_SYS_NICE or root): the threads keep niceness "
             f"{os.getpriority(os.PRIO_PROCESS, 0)}, so busy clients on this machine can delay "
             "the control loop")
@@ -67,7 +61,7 @@ def check_fifo_priority(priority: int) -> int:
     return priority
 
 
-def set_fifo(priority: int, log: Callable[[str], None], every_thread: bool = False) -> bool:
+def set_fifo(priority: int, log: Callable[[str], None]) -> bool:
     """Run the calling thread under SCHED_FIFO at `priority` (1 … 99; 0: leave it as it is);
     False, after one log line, where it is refused.
 
@@ -76,21 +70,16 @@ def set_fifo(priority: int, log: Callable[[str], None], every_thread: bool = Fal
     back by up to 10–19 ms (/clock silent 13.8 and 22.7 ms in two runs of the same case); under
     SCHED_FIFO 10, 5.8 ms. It is what ros2_control's controller_manager asks for (priority 50).
     Opt-in: a loop that falls behind steps without sleeping and then keeps a core from every
-    ordinary thread (the kernel's real-time throttling leaves them 5 % of each second).
-
-    `every_thread`: every thread of the process instead (and every thread they make later).
-    A thread that holds the GIL (or a lock of DDS's) the loop waits for must not be one that a
-    busy machine's ordinary processes can preempt: under a storm of 8 clients the loop then
-    waited until the scheduler ran that thread again."""
+    ordinary thread (the kernel's real-time throttling leaves them 5 % of each second)."""
     if check_fifo_priority(priority) == 0:
         return True
-    param = os.sched_param(priority)
-    done = _on_threads(lambda tid: os.sched_setscheduler(tid, os.SCHED_FIFO, param),
-                       thread_ids() if every_thread else [0])
-    if not done:
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    except PermissionError:
         log(f"real-time scheduling (SCHED_FIFO {priority}) refused (it needs CAP_SYS_NICE or "
             "root): the control loop runs at ordinary priority")
-    return done
+        return False
+    return True
 
 
 def freeze_heap() -> int:

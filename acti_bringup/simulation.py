@@ -48,12 +48,11 @@ class SimulationConfig:
     # niceness of the process's threads, -20 … 19 (lower runs first: the control loop before
     # the clients on a busy machine); below 0 needs CAP_SYS_NICE (root), else it is kept as is
     nice: int = ranged(-10, *NICE_RANGE)
-    # SCHED_FIFO priority of the simulation (control loop) thread and of the outbox that sends
-    # its messages, 1 … 99; every other thread of the process (serving, DDS) then runs at one
-    # below it (at least 1); 0 (the default): ordinary scheduling. Opt-in: a loop that falls behind steps without sleeping,
-    # and at FIFO it then keeps a core from every ordinary thread (two 4x-real-time jobs on a
-    # busy 2-core machine starved a service call for 30 s). Needs CAP_SYS_NICE (root); not
-    # applied when real_time_factor is 0
+    # SCHED_FIFO priority of the simulation (control loop) thread, 1 … 99; 0 (the default):
+    # ordinary scheduling. Opt-in: a loop that falls behind steps without sleeping, and at FIFO
+    # it then keeps a core from every ordinary thread (two 4x-real-time jobs on a busy 2-core
+    # machine starved a service call for 30 s). Needs CAP_SYS_NICE (root); not applied when
+    # real_time_factor is 0
     control_fifo_priority: int = ranged(0, *FIFO_RANGE)
 
 
@@ -94,23 +93,15 @@ class Simulation:
                 publish(world)
         self.executor.after_step(listened, every=self.executor.steps_per_period(rate_hz))
 
-    def _schedule_control_loop(self, below: int = 0) -> None:
+    def _schedule_control_loop(self) -> None:
         """On the simulation thread (and the outbox's, which sends the loop's messages):
-        real-time scheduling when the simulation keeps time. `below` > 0: every thread of the
-        process (the serving planes, DDS's own, all made later) `below` that priority.
-
-        Those threads take the GIL and DDS's locks the loop needs. At ordinary priority, a
-        client storm could preempt one of them while it held one, and the loop then waited
-        until the scheduler ran that thread again (/clock silent 24 ms under 8 storm clients;
-        every thread real-time: 7.6 ms). Below the loop, they yield a core to it at once."""
+        real-time scheduling when the simulation keeps time."""
         priority = self.config.control_fifo_priority
         if priority and self.config.real_time_factor == 0:
-            if not below:
-                self._log.info("control_fifo_priority not applied: real_time_factor 0 runs "
-                               "the simulation as fast as it can")
+            self._log.info("control_fifo_priority not applied: real_time_factor 0 runs the "
+                           "simulation as fast as it can")
             return
-        set_fifo(max(priority - below, 1) if priority else 0, self._log.warning,
-                 every_thread=below > 0)
+        set_fifo(priority, self._log.warning)
 
     def now(self) -> Time:
         return stamp(self.world.time)
@@ -135,7 +126,6 @@ class Simulation:
         for helper in helpers:
             planes.add(helper.plane, [helper])
         freeze_heap()
-        self._schedule_control_loop(below=1)                 # the planes' threads inherit it
         self.executor.start(prepare=self._schedule_control_loop)
         planes.outbox.put(self._schedule_control_loop)       # it carries the loop's messages
         planes.start()
