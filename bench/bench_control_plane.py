@@ -5,9 +5,12 @@ pause on the arm; and the largest /clock gap during each.
 
 Each trial starts a motion, loads the job, calls a bare std_srvs/Trigger (the baseline, same
 moment, same load) and then `stop`. Rest is when the stopped motion retires: when the job says
-that a ~/wait_motion goal on it ended (the DDS source timestamp of that goal status), and, as a
-second figure, when the goal's result reached this client (which adds this client's own delays:
-a storm takes both cores from it too). /clock gaps likewise: as the job sent them and as they
+that a ~/wait_motion goal on it ended (the DDS source timestamp of that goal status), counted
+from the call and, as the controller's own figure, from the job's answer to `stop` (the DDS
+source timestamp of the response: the stop is in force when the job answers, so this leaves
+out the request's way to the job, which a storm lengthens in this client's process); and, as
+a third figure, when the goal's result reached this client (which adds this client's own
+delays: a storm takes both cores from it too). /clock gaps likewise: as the job sent them and as they
 arrived. Ratios are against the bare round trip and the control period measured in
 the same run (the /clock increment). Goals: stop reply p99 <= 3x bare, rest within the decel
 time + 2 control periods, /clock never silent for more than 2 control periods.
@@ -49,6 +52,25 @@ QUEUE = 8                           # queue_size of both devices
 STORM_CLIENTS = 8
 ARM_DECEL_S = 0.3                   # accel_time_joint
 BASE_DECEL_S = 300.0 / 500.0        # default velocity / default acceleration (translation)
+
+
+ANSWER_STAMPS: dict[int, float] = {}     # id(response) → its DDS source timestamp [s, wall]
+
+
+def record_answer_stamps() -> None:
+    """Keep the DDS source timestamp of every response this process takes (rclpy's executors
+    drop the header): the job's own moment of answering."""
+    from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+    take = _rclpy.Client.take_response
+
+    def taking(handle: Any, response_type: type) -> Any:
+        header, response = taken = take(handle, response_type)
+        if header is not None:
+            if len(ANSWER_STAMPS) > 10_000:
+                ANSWER_STAMPS.clear()
+            ANSWER_STAMPS[id(response)] = header.source_timestamp * 1e-9
+        return taken
+    _rclpy.Client.take_response = taking
 
 
 class Background:
@@ -183,6 +205,7 @@ class Figures:
     bare: list[float]
     rest: list[float]    # stop called → the wait's result here
     rest_job: list[float]    # stop called → the job said the wait ended (status source stamp)
+    rest_answered: list[float]   # the job answered stop → it said the wait ended (both stamps)
     clock_gap: float     # the job's largest /clock silence (source timestamps)
     clock_arrival_gap: float     # ... as seen by this client
     lost: list[str]      # the step each lost trial timed out in
@@ -223,10 +246,10 @@ def running_motion(ros: RosClient, device: Device, waiter: Actions,
 
 def run_trials(ros: RosClient, bg: Background, device: Device, load: Load,
                waiter: Actions) -> Figures:
-    f = Figures([], [], [], [], 0.0, 0.0, [])
+    f = Figures([], [], [], [], [], 0.0, 0.0, [])
     for trial in range(-1, TRIALS):                     # trial -1 warms up (lazy imports)
         if trial == 0:
-            f, t0 = Figures([], [], [], [], 0.0, 0.0, []), time.monotonic()
+            f, t0 = Figures([], [], [], [], [], 0.0, 0.0, []), time.monotonic()
         try:
             trial_figures(ros, bg, device, load, waiter, trial, f)
         except TimeoutError as e:
@@ -247,8 +270,9 @@ def trial_figures(ros: RosClient, bg: Background, device: Device, load: Load, wa
     bare()
     f.bare.append(time.perf_counter() - t)
     wall, t = time.time(), time.perf_counter()
-    ros.call(device.stop_srv, device.path + "stop")
+    answer = ros.call(device.stop_srv, device.path + "stop")
     f.reply.append(time.perf_counter() - t)
+    answered = ANSWER_STAMPS.pop(id(answer), None)
     if not ros.wait(result, 30.0):
         raise TimeoutError("the stopped motion never retired")
     f.rest.append(time.perf_counter() - t)
@@ -256,6 +280,8 @@ def trial_figures(ros: RosClient, bg: Background, device: Device, load: Load, wa
     if not ros.spin_until(lambda: uuid in bg.goal_ended, 5.0):
         raise TimeoutError("no goal status said the wait ended")
     f.rest_job.append(bg.goal_ended[uuid] - wall)
+    if answered is not None:
+        f.rest_answered.append(bg.goal_ended[uuid] - answered)
     ros.call(device.stop_srv, device.path + "stop")     # what a load queued meanwhile
     if isinstance(held, list):
         for future in held:                              # held goals end with the motion
@@ -370,6 +396,7 @@ def lost_text(lost: list[str]) -> str:
 
 def main(cases: str) -> None:
     """`cases`: the letters of the cases to run (all when empty)."""
+    record_answer_stamps()
     ros = RosClient(call_timeout=5.0)
     # /clock on every control step (clock_rate_hz = rate_hz), so its gaps show every stall
     params = (f"max_action_goals:={MAX_GOALS}", f"max_wait_goals:={MAX_GOALS}",
@@ -385,8 +412,8 @@ def main(cases: str) -> None:
         print(f"stop under load, main job, {TRIALS} trials per case; control period "
               f"{period * 1e3:.2f} ms (from /clock); times in ms")
         print(f"{'case':<40} {'dev':<5} {'bare p50/p99':>15} {'stop reply p50/p99/max':>25} "
-              f"{'ratio p99':>9} {'rest p50/p99/max':>25} {'goal':>7} {'received p99':>12} "
-              f"{'/clock gap':>10}")
+              f"{'ratio p99':>9} {'rest p50/p99/max':>25} {'goal':>7} {'answered→p99':>12} "
+              f"{'received p99':>12} {'/clock gap':>10}")
         # one action client per device for the whole run: each new one would add entities to
         # both processes (and receivers of every goal status) for the rest of the run
         waiters = {d.name: Actions(ros, d.wait_action, d.path + "wait_motion") for d in DEVICES}
@@ -402,7 +429,8 @@ def main(cases: str) -> None:
                           f"{p(np.array(f.bare), 99):7.2f} {p(reply, 50):7.2f}/{p(reply, 99):7.2f}/"
                           f"{reply.max() * 1e3:8.2f} {p(reply, 99) / p(np.array(f.bare), 99):9.2f}"
                           f" {p(rest, 50):7.1f}/{p(rest, 99):7.1f}/{rest.max() * 1e3:7.1f}"
-                          f" {goal * 1e3:7.1f} {p(np.array(f.rest), 99):12.1f}"
+                          f" {goal * 1e3:7.1f} {p(np.array(f.rest_answered or [np.nan]), 99):12.1f}"
+                          f" {p(np.array(f.rest), 99):12.1f}"
                           f" {f.clock_gap * 1e3:7.1f} "
                           f"({f.clock_gap / period:.1f} periods; {f.clock_arrival_gap * 1e3:.1f}"
                           f" as it arrived)" + lost_text(f.lost))
