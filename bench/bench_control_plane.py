@@ -13,7 +13,9 @@ a third figure, when the goal's result reached this client (which adds this clie
 delays: a storm takes both cores from it too). /clock gaps likewise: as the job sent them and as they
 arrived. Ratios are against the bare round trip and the control period measured in
 the same run (the /clock increment). Goals: stop reply p99 <= 3x bare, rest within the decel
-time + 2 control periods, /clock never silent for more than 2 control periods.
+time + 2 control periods, /clock never silent for more than 2 control periods. A trial whose
+call went unanswered is counted as lost, beside the UDP datagrams the kernel dropped at full
+socket receive buffers meanwhile (what loses calls under a storm: `net.core.rmem_default`).
 
     python bench/bench_control_plane.py            (a few minutes)
     python bench/bench_control_plane.py --cases cd (only cases (c) and (d))
@@ -386,12 +388,22 @@ def scenarios(ros: RosClient, bg: Background,
     }
 
 
-def lost_text(lost: list[str]) -> str:
-    """How many trials lost a call, and in which step."""
+def udp_receive_drops() -> int:
+    """UDP datagrams this machine's kernel dropped so far because a socket's receive buffer was
+    full (`RcvbufErrors`): a reliable DDS writer sends such a sample again only after its next
+    heartbeat, seconds later, which is how a storm loses calls."""
+    with open("/proc/net/snmp") as f:
+        names, values = [line.split()[1:] for line in f if line.startswith("Udp:")][:2]
+    return int(values[names.index("RcvbufErrors")])
+
+
+def lost_text(lost: list[str], dropped: int) -> str:
+    """How many trials lost a call, and in which step; UDP datagrams dropped meanwhile."""
+    drops = f"  {dropped} UDP datagrams dropped at full receive buffers" if dropped else ""
     if not lost:
-        return ""
+        return drops
     return f"  {len(lost)} trials lost a call: " + "; ".join(
-        f"{lost.count(why)}x {why}" for why in dict.fromkeys(lost))
+        f"{lost.count(why)}x {why}" for why in dict.fromkeys(lost)) + drops
 
 
 def main(cases: str) -> None:
@@ -422,7 +434,9 @@ def main(cases: str) -> None:
                 continue
             with context():
                 for device in DEVICES:
+                    drops = udp_receive_drops()
                     f = run_trials(ros, bg, device, load, waiters[device.name])
+                    drops = udp_receive_drops() - drops
                     reply, rest = np.array(f.reply), np.array(f.rest_job)
                     goal = device.decel_s + 2 * period
                     print(f"{name:<40} {device.name:<5} {p(np.array(f.bare), 50):7.2f}/"
@@ -433,7 +447,7 @@ def main(cases: str) -> None:
                           f" {p(np.array(f.rest), 99):12.1f}"
                           f" {f.clock_gap * 1e3:7.1f} "
                           f"({f.clock_gap / period:.1f} periods; {f.clock_arrival_gap * 1e3:.1f}"
-                          f" as it arrived)" + lost_text(f.lost))
+                          f" as it arrived)" + lost_text(f.lost, drops))
         bg.close()
     ros.close()
 
