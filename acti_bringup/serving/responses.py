@@ -106,11 +106,13 @@ class UnlockedSender:
         copied = request_id(address)
 
         def send() -> bool:
+            # noted before it is sent: once answered, the client may call again at once
+            if len(self._answered) >= self.ANSWERED_KEPT:
+                self._answered.clear()
+            self._answered.add(client)
             sent = message.send(self._handle, lambda s, m: lib.send_response(s, copied, m))
-            if sent:
-                if len(self._answered) >= self.ANSWERED_KEPT:
-                    self._answered.clear()
-                self._answered.add(client)
+            if not sent:
+                self._answered.discard(client)
             return sent
         return Prepared(send, message.discard)
 
