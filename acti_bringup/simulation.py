@@ -88,10 +88,14 @@ class Simulation:
         """Run publish(world) on the simulation thread at about rate_hz while one of `publishers`
         has a subscriber. Building messages nobody receives was most of an idle robot's Python
         work; a volatile topic without subscribers shows nothing, so skipping it changes nothing."""
+        def received() -> bool:
+            return any(p.get_subscription_count() for p in publishers)
+
         def listened(world: World) -> None:
-            if any(p.get_subscription_count() for p in publishers):
+            if received():
                 publish(world)
-        self.executor.after_step(listened, every=self.executor.steps_per_period(rate_hz))
+        self.executor.after_step(listened, every=self.executor.steps_per_period(rate_hz),
+                                 on_time=received)
 
     def _schedule_control_loop(self) -> None:
         """On the simulation thread (and the outbox's, which sends the loop's messages):

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import math
 import threading
 import time
 from collections import deque
@@ -115,6 +116,7 @@ class Device:
         self._discards = DiscardLog()     # what stops, halts and take-overs discarded
         self._reason = STOPPED      # why the present stop discards (a motion arriving meanwhile)
         self._retire_listeners: list[Callable[[], None]] = []
+        self.wake: Callable[[], None] = lambda: None    # the loop: work came (`MotionExecutor`)
 
     # --- called by cores (any thread) -------------------------------------------------------
     @property
@@ -138,6 +140,11 @@ class Device:
     @property
     def full(self) -> bool:
         return len(self.queue) >= self.capacity
+
+    @property
+    def idle(self) -> bool:
+        """Nothing runs or waits to run: the loop has nothing to command it."""
+        return self.current is None and not self.queue
 
     def submit(self, plan: Callable[[Any], Motion], label: str) -> int | None:
         """Plan a motion from the end of the last queued one and append it; its id, or None when
@@ -187,6 +194,7 @@ class Device:
                     if self._stop_at is None:
                         self.queued_end = self._end_of_queue()
                     self.changed.notify_all()
+                    self.wake()
                     return ids
 
     def arrival(self) -> int:
@@ -261,6 +269,7 @@ class Device:
             self.revision += 1
             self.queued_end = self._end_of_queue()
             self.changed.notify_all()
+            self.wake()
             return out
 
     def edit_planned(self, look: Callable[["Device", int], Any],
@@ -289,6 +298,7 @@ class Device:
                 self.revision += 1
                 self.queued_end = self._end_of_queue()
                 self.changed.notify_all()
+                self.wake()
                 return out
         return STALE
 
@@ -318,6 +328,7 @@ class Device:
                 self.queue.append(QueuedMotion(self.last_id, *then))
                 self.queued_end = self._end_of_queue()
             self.changed.notify_all()
+            self.wake()
 
     @contextlib.contextmanager
     def idle_for_settings(self) -> Iterator[bool]:
@@ -513,6 +524,7 @@ class _Listener:
     every: float        # steps between two calls, on average
     due: float          # the step count of the next call
     fn: StepListener
+    on_time: Callable[[], bool] | None     # its steps are due on time, also while idle
 
 
 class MotionExecutor:
@@ -524,6 +536,11 @@ class MotionExecutor:
     it then steps back to back until it has caught up."""
 
     BEHIND_REPORT_S = 0.05
+    # An idle loop (no device has a motion) wakes this often at most, and at once when a device
+    # is given work; on waking it runs the steps that fell due back to back. Each wake costs
+    # more than an idle step (the sleep, cold caches: ~3x a step's Python work), and a step that
+    # commands nothing changes nothing by running later: the physics is the same step by step.
+    IDLE_WAKE_S = 0.02
 
     def __init__(self, world: World, real_time_factor: float = 1.0,
                  alive: Callable[[], bool] = lambda: True) -> None:
@@ -538,6 +555,7 @@ class MotionExecutor:
         self._after: list[_Listener] = []
         self._thread: threading.Thread | None = None
         self._running = threading.Event()
+        self._work = threading.Event()      # a device was given work: an idle loop wakes
         self.steps = 0
         self.falls_behind = 0           # how often the loop fell BEHIND_REPORT_S behind
         self.error: Exception | None = None     # what ended the loop, if an error did
@@ -546,6 +564,7 @@ class MotionExecutor:
     def add_device(self, name: str, capacity: int, hold: Any) -> Device:
         """A motion queue whose device rests at set-point `hold` until its first motion."""
         device = Device(name, capacity, hold)
+        device.wake = self._work.set
         self.devices[name] = device
         return device
 
@@ -553,12 +572,15 @@ class MotionExecutor:
         """Run fn(world) on the simulation thread before the devices are advanced."""
         self._before.append(fn)
 
-    def after_step(self, fn: StepListener, every: float = 1.0) -> None:
+    def after_step(self, fn: StepListener, every: float = 1.0,
+                   on_time: Callable[[], bool] | None = None) -> None:
         """Run fn(world) on the simulation thread after every `every`-th physics step. A
         fractional `every` alternates between the whole numbers around it, so that the rate is
-        kept on average (100 Hz at 250 Hz: every 2, 3, 2, 3 … steps; rounding gave 125 Hz)."""
+        kept on average (100 Hz at 250 Hz: every 2, 3, 2, 3 … steps; rounding gave 125 Hz).
+        While `on_time()` says so (a publication someone receives), an idle loop still wakes
+        for each of fn's steps (`IDLE_WAKE_S`)."""
         every = max(1.0, every)
-        self._after.append(_Listener(every, self.steps + every, fn))
+        self._after.append(_Listener(every, self.steps + every, fn, on_time))
 
     def steps_per_period(self, rate_hz: float) -> float:
         """The `every` of a listener that runs at rate_hz (at most once a step)."""
@@ -599,6 +621,7 @@ class MotionExecutor:
 
     def shutdown(self) -> None:
         self._running.clear()
+        self._work.set()
         if self._thread is not None:
             self._thread.join(timeout=5.0)
             self._thread = None
@@ -619,8 +642,24 @@ class MotionExecutor:
             if self.real_time_factor > 0:
                 ahead = (self.world.time - sim0) / self.real_time_factor - (time.monotonic() - wall0)
                 self._note_lateness(-ahead)
-            # Sleeping (even 0 s) hands the GIL to service threads once per step.
-            time.sleep(max(ahead, 0.0))
+            self._work.clear()          # before looking: work given from now on wakes the wait
+            idle_steps = self._idle_steps() if ahead > 0 else 0
+            if idle_steps:
+                self._work.wait(ahead + idle_steps * self.dt / self.real_time_factor)
+            else:
+                # Sleeping (even 0 s) hands the GIL to service threads once per step.
+                time.sleep(max(ahead, 0.0))
+
+    def _idle_steps(self) -> int:
+        """How many steps past the next an idle loop may sleep (0: not idle): none while a
+        device has a motion, and none past a step of an on-time listener."""
+        if not all(d.idle for d in self.devices.values()):
+            return 0
+        extra = int(self.IDLE_WAKE_S * self.real_time_factor / self.dt) - 1
+        for listener in self._after:
+            if extra > 0 and listener.on_time is not None and listener.on_time():
+                extra = min(extra, math.ceil(listener.due - 1e-9) - self.steps - 1)
+        return max(extra, 0)
 
     def _note_lateness(self, behind: float) -> None:
         """Report a fall behind the schedule once, when it begins; ready again once caught up."""
