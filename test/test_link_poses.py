@@ -53,6 +53,27 @@ def test_odometry_stays_continuous_through_a_reset_and_its_covariance_grows():
     assert odo.twist_variance[0] > 0 and odo.v == pytest.approx(1.0, rel=0.01)
 
 
+def test_the_covariance_propagates_as_the_first_order_matrix_form_says():
+    """F P Fᵀ + G Q Gᵀ written out in floats: the same as with the matrices, step by step."""
+    from acti_motion.vehicle.paths import WHEEL_VARIANCE_PER_M
+    rng = np.random.default_rng(5)
+    odo, wheels, P, b = Odometry(0.1, 0.5, np.zeros(2)), np.zeros(2), np.zeros((3, 3)), 0.5
+    for _ in range(300):
+        theta = odo.pose.theta - odo.frame.theta
+        step = rng.normal(0.0, 0.02, 2) + [0.03, 0.01]
+        wheels = wheels + step
+        odo.update(wheels, 1 / 250)
+        dl, dr = step * 0.1
+        ds, dth = (dl + dr) / 2, (dr - dl) / b
+        c, s, k = math.cos(theta + dth / 2), math.sin(theta + dth / 2), ds / (2 * b)
+        F = np.array([[1.0, 0.0, -ds * s], [0.0, 1.0, ds * c], [0.0, 0.0, 1.0]])
+        G = np.array([[c / 2 - k * s, c / 2 + k * s], [s / 2 + k * c, s / 2 - k * c],
+                      [1 / b, -1 / b]])
+        Q = np.diag([WHEEL_VARIANCE_PER_M * abs(dr), WHEEL_VARIANCE_PER_M * abs(dl)])
+        P = F @ P @ F.T + G @ Q @ G.T
+        assert np.allclose(odo.covariance, P, rtol=1e-9, atol=1e-18)
+
+
 def test_a_quaternion_from_a_rotation_is_pinocchios_and_leaks_nothing():
     """pin.Quaternion(R) leaked about 80 bytes a call: the arm node's ~/state grew the main job
     by 90 kB a minute, idle."""
