@@ -94,6 +94,7 @@ class World:
         # gives one each step, so it never sleeps while commanded, however slowly it moves.
         p.changeDynamics(self.robot, -1, activationState=pybullet.ACTIVATION_STATE_ENABLE_SLEEPING)
         self._arm_ids = [self._joint[n] for n in ARM_JOINTS]
+        self._arm_forces = [self.limits[n].effort for n in ARM_JOINTS]
         self._grip_ids = [self._joint[n] for n in GRIPPER_JOINTS]
         self._wheel_ids = [self._joint[n] for n in WHEEL_JOINTS]
         self._sensed_ids = [*self._arm_ids, self._grip_ids[0], *self._wheel_ids]
@@ -170,13 +171,13 @@ class World:
 
     def set_arm_targets(self, q: np.ndarray, qd: np.ndarray | None = None) -> None:
         """Track joint positions (rad) with feed-forward velocities (rad/s) through stiff motors."""
-        qd = np.zeros(len(q)) if qd is None else qd
-        forces = [self.limits[n].effort for n in ARM_JOINTS]
+        n = len(self._arm_ids)
         self._wake()
         self._p.setJointMotorControlArray(
-            self.robot, self._arm_ids, pybullet.POSITION_CONTROL, targetPositions=list(q),
-            targetVelocities=list(qd), forces=forces,
-            positionGains=[0.3] * len(q), velocityGains=[1.0] * len(q))
+            self.robot, self._arm_ids, pybullet.POSITION_CONTROL,
+            targetPositions=np.asarray(q, float).tolist(),
+            targetVelocities=[0.0] * n if qd is None else np.asarray(qd, float).tolist(),
+            forces=self._arm_forces, positionGains=[0.3] * n, velocityGains=[1.0] * n)
 
     def arm_positions(self) -> np.ndarray:
         return np.array(self._sensed()[:len(self._arm_ids)])

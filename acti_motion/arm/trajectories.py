@@ -158,16 +158,22 @@ class ArmMotion:
         self.finger0, self.dfinger = finger0, finger1 - finger0
         self.duration = timing.duration
         self.limits_checked: np.ndarray | None = None   # the soft limits its plan was checked with
+        self._applied: tuple[float, ArmSetpoint] | None = None
 
     def at(self, t: float) -> ArmSetpoint:
+        applied = self._applied
+        if applied is not None and applied[0] == t:     # the soft-limit watch, after `apply`
+            return applied[1]
         s, _ = self.timing.sample(t)
         return ArmSetpoint(self.path.q(s), self.finger0 + s * self.dfinger)
 
     def apply(self, world: World, t: float, rate: float) -> None:
         s, ds = self.timing.sample(t)
-        world.set_arm_targets(self.path.q(s), rate * ds * self.path.dq(s))
+        point = ArmSetpoint(self.path.q(s), self.finger0 + s * self.dfinger)
+        self._applied = (t, point)
+        world.set_arm_targets(point.joints, rate * ds * self.path.dq(s))
         if self.dfinger:
-            world.set_gripper_target(self.finger0 + s * self.dfinger)
+            world.set_gripper_target(point.finger)
 
 
 # --- Cartesian paths of the control point (robot frame, m) ---------------------------------------

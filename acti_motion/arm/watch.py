@@ -76,7 +76,7 @@ class SoftLimitWatch:
             self._inside = self._within_watch_limits(d.hold.joints)[1]
         values, inside = self._within_watch_limits(cur.motion.at(d.t).joints)
         was, self._inside = self._inside, inside
-        if self._alarms:
+        if self._alarms or inside.all():
             return
         checked = getattr(cur.motion, "limits_checked", None)
         changed = (np.ones(len(inside), bool) if checked is None
@@ -110,9 +110,18 @@ class SoftLimitWatch:
         them lie within the soft limits widened by the watch tolerances."""
         p = self.frames.tool_of(self.kin.flange(q))[:3, 3] * 1000.0
         values = np.concatenate([np.degrees(q), p])
-        lj, lc = self.soft_limit_joint, self.soft_limit_cartesian
-        lower = np.concatenate([lj[:, 0] - JOINT_WATCH_TOLERANCE_DEG,
-                                lc[:, 0] - CARTESIAN_WATCH_TOLERANCE_MM])
-        upper = np.concatenate([lj[:, 1] + JOINT_WATCH_TOLERANCE_DEG,
-                                lc[:, 1] + CARTESIAN_WATCH_TOLERANCE_MM])
+        lower, upper = self._watch_bounds()
         return values, (values >= lower) & (values <= upper)
+
+    def _watch_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """The soft limits widened by the watch tolerances (lower, upper), made again only when
+        a limit was set (each setter assigns new arrays): the watch runs every moving step."""
+        lj, lc = self.soft_limit_joint, self.soft_limit_cartesian
+        made = getattr(self, "_bounds_made", None)
+        if made is None or made[0] is not lj or made[1] is not lc:
+            lower = np.concatenate([lj[:, 0] - JOINT_WATCH_TOLERANCE_DEG,
+                                    lc[:, 0] - CARTESIAN_WATCH_TOLERANCE_MM])
+            upper = np.concatenate([lj[:, 1] + JOINT_WATCH_TOLERANCE_DEG,
+                                    lc[:, 1] + CARTESIAN_WATCH_TOLERANCE_MM])
+            made = self._bounds_made = (lj, lc, lower, upper)
+        return made[2], made[3]

@@ -65,7 +65,7 @@ class Odometry:
 
     def __init__(self, wheel_radius: float, wheel_separation: float, wheels: np.ndarray) -> None:
         self.r, self.b = wheel_radius, wheel_separation
-        self._last = wheels.copy()
+        self._last = tuple(map(float, wheels))
         self.pose = Pose2D(0.0, 0.0, 0.0)
         self.frame = Pose2D(0.0, 0.0, 0.0)
         self._cov = (0.0,) * 6          # the covariance's upper triangle: xx xy xθ yy yθ θθ
@@ -75,8 +75,9 @@ class Odometry:
         self.lock = threading.Lock()
 
     def update(self, wheels: np.ndarray, dt: float) -> None:
-        dl, dr = (wheels - self._last) * self.r
-        self._last = wheels.copy()
+        left, right = map(float, wheels)        # floats: numpy scalars cost ~5x a step here
+        dl, dr = (left - self._last[0]) * self.r, (right - self._last[1]) * self.r
+        self._last = (left, right)
         ds, dth = (dl + dr) / 2, (dr - dl) / self.b
         with self.lock:
             p = self.pose
