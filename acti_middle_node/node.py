@@ -71,6 +71,8 @@ class ArmNode(Node):
 
     def _publish_state(self) -> None:
         sync_parameters(self)             # settings changed through the services, as parameters
+        if not self._state.get_subscription_count():
+            return      # a volatile topic nobody receives: the message (its FK) would be lost
         core = self.core
         t, q = core.measured()
         pose = core.tool_pose(q)
