@@ -25,3 +25,40 @@ def test_a_nested_message_with_an_array_inside_is_built_from_lists_tuples_or_arr
     fill(b, {"pos": (np.array(hg), np.float64(30.0), 1)})
     for r in (a, b):
         assert list(r.pos.car_pos) == hg and r.pos.elbow == 30.0 and r.pos.struct_flag == 1
+
+
+class _Node:
+    """What an operation's handler needs of its node: a logger."""
+
+    def __init__(self) -> None:
+        self.errors: list[str] = []
+
+    def get_logger(self):
+        return self
+
+    def error(self, text: str) -> None:
+        self.errors.append(text)
+
+
+def test_an_unchanged_reply_is_answered_with_the_response_that_carried_it():
+    """A getter asked again while nothing changed answers with the same response object (its C
+    message is kept by the sender: no filling, no conversion); a changed reply gets a response
+    of its own."""
+    from acti_bringup.serving.adapter import Operation, _handler
+    from acti_middle_node.node import write_return_id
+    from acti_motion.replies import Reply
+    limits = {"soft_limit": LIMITS}
+    node = _Node()
+    handle = _handler(node, Operation("get_soft_limit_joint", GetSoftLimitJoint),
+                      lambda: Reply(values=limits["soft_limit"] and dict(limits)), write_return_id)
+    ask = lambda: handle(GetSoftLimitJoint.Request(), GetSoftLimitJoint.Response())  # noqa: E731
+    first = ask()
+    assert ask() is first and ask() is first
+    limits["soft_limit"] = [(170.0, -170.0), (121.0, -120.0)]
+    changed = ask()
+    assert changed is not first
+    assert [(v.upper, v.lower) for v in changed.soft_limit] == limits["soft_limit"]
+    assert ask() is changed
+    limits["soft_limit"] = LIMITS
+    again = ask()
+    assert again is not first and [(v.upper, v.lower) for v in again.soft_limit] == LIMITS

@@ -12,7 +12,7 @@ import time
 
 import pytest
 from acti_msgs.msg import LimitValue
-from acti_msgs.srv import GetSoftLimitJoint
+from acti_msgs.srv import GetSoftLimitJoint, SetSpeedJoint
 from std_msgs.msg import Float64MultiArray, String
 from std_srvs.srv import Trigger
 
@@ -188,3 +188,26 @@ def test_the_gil_is_free_while_rcl_sends():
     lib = rcl()
     for send in (lib.send_response, lib.publish, lib.publish_feedback, *lib.action_answers.values()):
         assert not send._flags_ & ctypes._FUNCFLAG_PYTHONAPI
+
+
+
+def test_a_response_answered_again_reuses_its_kept_c_message(ros, events_loop):
+    """A callback that answers an unchanged reply with the same response object (as the
+    operations' handlers do) is answered from the C message kept for it; switching between
+    responses frees the older one and sends the right values every time."""
+    node, loop = events_loop
+    responses: dict[int, SetSpeedJoint.Response] = {}
+
+    def one_per_ratio(request, fresh):
+        if request.spd_ratio not in responses:
+            fresh.return_id.comment = f"ratio {request.spd_ratio}"
+            responses[request.spd_ratio] = fresh
+        return responses[request.spd_ratio]
+    node.create_service(SetSpeedJoint, "~/kept", one_per_ratio)
+    outbox = Outbox(print)
+    LateResponses(print, outbox).serve([node])
+    loop.start()
+    for ratio in (1, 1, 1, 2, 2, 1, 1, 3, 3, 1):
+        r = ros.call(SetSpeedJoint, "/spin_loop_test/kept", spd_ratio=ratio)
+        assert r.return_id.comment == f"ratio {ratio}"
+    outbox.stop()

@@ -15,7 +15,7 @@ from rclpy.action import ActionServer
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-from acti_bringup.serving.conversions import fill, request_reader
+from acti_bringup.serving.conversions import fill, frozen, request_reader
 from acti_motion.replies import Reply, ReturnCode
 
 @dataclass(frozen=True)
@@ -91,13 +91,24 @@ def serve_operations(node: Node, motion: Plane, core: Any,
 
 def _handler(node: Node, op: Operation, method: Callable[..., Reply],
              write_status: StatusWriter) -> Callable[[Any, Any], Any]:
+    """The service callback of one operation. A reply equal to the last one (a getter asked
+    again while nothing changed) is answered with the response that carried it: filling it
+    and converting it to its C message (kept by `UnlockedSender`) were most of a getter's work
+    in the job (the soft limits: 31 µs of 38 on a warm core). Responses are never changed once
+    returned."""
     read = request_reader(op.srv_type.Request)
+    last: tuple[Any, Any] = (None, None)      # the last reply, hashable, and its response
 
     def handle(request: Any, response: Any) -> Any:
+        nonlocal last
         try:
             reply = method(**read(request))
+            key = frozen((reply.code, reply.comment, tuple(reply.values.items())))
+            if key is not None and key == last[0]:
+                return last[1]
             write_status(response, reply)
             fill(response, reply.values)
+            last = (key, response)
         except Exception as e:  # a bug must not take the node down; the caller is told
             node.get_logger().error(f"{op.name} failed: {traceback.format_exc()}")
             write_status(response, Reply(ReturnCode.NG, f"internal error in {op.name}: {e}"))

@@ -74,7 +74,7 @@ _BUILT: dict[tuple[int, Any], Any] = {}
 _BUILT_MAX = 512
 
 
-def _frozen(value: Any) -> Any:
+def frozen(value: Any) -> Any:
     """A hashable copy of a core value (lists and arrays → tuples), or None if it has none."""
     if isinstance(value, np.ndarray):
         value = value.tolist()
@@ -86,7 +86,7 @@ def _frozen(value: Any) -> Any:
     except TypeError:
         if not isinstance(value, tuple):
             return None
-    items = tuple(_frozen(v) for v in value)
+    items = tuple(frozen(v) for v in value)
     return None if None in items else items
 
 
@@ -112,10 +112,10 @@ def _cached(slot: Any, value: Any, build: Callable[[], Any]) -> Any:
     last = _LAST.get(id(slot))
     if last is not None and last[0] is value:   # a core that memoises answered the same object
         return last[1]
-    frozen = _frozen(value)
-    if frozen is None:
+    hashable = frozen(value)
+    if hashable is None:
         return build()
-    key = (id(slot), frozen)
+    key = (id(slot), hashable)
     built = _BUILT.get(key)
     if built is None:
         if len(_BUILT) >= _BUILT_MAX:

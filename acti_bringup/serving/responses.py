@@ -76,7 +76,7 @@ class RclpySender:
     def __init__(self, service: Any) -> None:
         self._send = service.send_response
 
-    def prepare(self, response: Any, header: Any) -> Prepared:
+    def prepare(self, response: Any, header: Any, again: bool = False) -> Prepared:
         return Prepared(lambda: delivered(self._send, response, header))
 
 
@@ -84,7 +84,9 @@ class UnlockedSender:
     """Prepares responses for rcl's send without the GIL (`unlocked`), converted now: to be sent
     now (on the serving thread) to a client answered before (by its request writer's GUID),
     through the outbox to a new one. Where the header cannot be read or rcl is not found,
-    rclpy's send (through the outbox)."""
+    rclpy's send (through the outbox). The C message of the last response sent at once is kept:
+    the service callback answers an unchanged reply with the same response object
+    (`acti_bringup.serving.adapter`), which is then not converted again."""
 
     ANSWERED_KEPT = 4096
 
@@ -93,16 +95,22 @@ class UnlockedSender:
         self._handle = service.handle
         self._kind = MessageKind(service.srv_type.Response)
         self._answered: set[bytes] = set()
+        self._kept: tuple[Any, CMessage] | None = None    # serving thread only
 
-    def prepare(self, response: Any, header: Any) -> Prepared:
+    def prepare(self, response: Any, header: Any, again: bool = False) -> Prepared:
+        """`again`: a response sent again off the serving thread (it never takes the kept C
+        message, which the serving thread frees when it keeps another)."""
         lib = rcl()
         address = header_address(header) if lib is not None else None
         if address is None:
             return self._rclpy.prepare(response, header)
-        client, message = ctypes.string_at(address, GUID_BYTES), CMessage(self._kind, response)
-        if client in self._answered:        # header and message live until it is sent, here
+        client = ctypes.string_at(address, GUID_BYTES)
+        if client in self._answered and not again:  # header and message live until it is sent
+            message = self._converted(response)
             return Prepared(lambda: message.send(
-                self._handle, lambda s, m: lib.send_response(s, address, m)), message.discard, True)
+                self._handle, lambda s, m: lib.send_response(s, address, m), keep=True),
+                lambda: None, True)
+        message = CMessage(self._kind, response)
         copied = request_id(address)
 
         def send() -> bool:
@@ -115,6 +123,18 @@ class UnlockedSender:
                 self._answered.discard(client)
             return sent
         return Prepared(send, message.discard)
+
+    def _converted(self, response: Any) -> CMessage:
+        """`response`'s C message: the kept one when it is the response sent last, else a new
+        one, kept instead (the old one is freed: its send is over, on this same thread)."""
+        kept = self._kept
+        if kept is not None and kept[0] is response:
+            return kept[1]
+        message = CMessage(self._kind, response)
+        self._kept = (response, message)
+        if kept is not None:
+            kept[1].discard()
+        return message
 
 
 Sender = Callable[[Any], "RclpySender | UnlockedSender"]
@@ -183,7 +203,7 @@ class LateResponses:
                     self._wake.wait(None if not self._due else self._due[0][0] - time.monotonic())
                 _, _, attempt, sender, response, header, name = heapq.heappop(self._due)
             try:
-                if sender.prepare(response, header).send():
+                if sender.prepare(response, header, again=True).send():
                     continue
             except Exception as e:   # the service was destroyed, the process ends
                 self._log(f"response to {name} not sent again: {e}")

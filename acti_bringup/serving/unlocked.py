@@ -89,15 +89,17 @@ class CMessage:
     def __init__(self, kind: "MessageKind", msg: Any) -> None:
         self._kind, self._pointer = kind, kind.convert(msg)
 
-    def send(self, entity: Any, rcl_send: Callable[[int, int], int]) -> bool:
+    def send(self, entity: Any, rcl_send: Callable[[int, int], int], keep: bool = False) -> bool:
         """rcl_send(entity pointer, C message), GIL-free: True when sent, False on an rcl
         timeout, RuntimeError otherwise. `entity`: rclpy's handle, kept alive meanwhile (an
-        InvalidHandle error once it is destroyed). The C message is freed either way."""
+        InvalidHandle error once it is destroyed). The C message is freed either way, unless
+        `keep` (to be sent again: rcl only reads it; `discard` frees it)."""
         try:
             with entity:
                 ret = rcl_send(entity.pointer, self._pointer)
         finally:
-            self.discard()
+            if not keep:
+                self.discard()
         if ret == RCL_RET_OK:
             return True
         reason = rcl().error()
