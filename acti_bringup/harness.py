@@ -73,7 +73,9 @@ class RosClient:
         """The first client of a process initialises rclpy (and shuts it down on close)."""
         import rclpy
         from rclpy.executors import SingleThreadedExecutor
+        from acti_bringup.serving.adapter import CLIENT_QOS
         self.rclpy = rclpy
+        self.client_qos = CLIENT_QOS      # a busy client keeps its answer among others' (adapter)
         self._owns_context = not rclpy.ok()
         if self._owns_context:
             rclpy.init()
@@ -86,7 +88,8 @@ class RosClient:
     def call(self, srv_type: type, name: str, **fields: Any) -> Any:
         client = self._clients.get(name)
         if client is None:
-            client = self._clients[name] = self.node.create_client(srv_type, name)
+            client = self._clients[name] = self.node.create_client(srv_type, name,
+                                                                   qos_profile=self.client_qos)
         # also after the server's process was restarted (the next test module's node)
         if not client.service_is_ready() and not client.wait_for_service(timeout_sec=SERVICE_TIMEOUT):
             raise TimeoutError(f"service {name} did not appear")
@@ -122,8 +125,9 @@ class Actions:
 
     def __init__(self, ros: "RosClient", action_type: type, name: str) -> None:
         from rclpy.action import ActionClient
+        from acti_bringup.serving.adapter import CLIENT_ACTION_QOS
         self.ros, self.type = ros, action_type
-        self.client = ActionClient(ros.node, action_type, name)
+        self.client = ActionClient(ros.node, action_type, name, **CLIENT_ACTION_QOS)
         assert self.client.wait_for_server(timeout_sec=30.0)
 
     def spin(self, future: Any, timeout: float = ACTION_TIMEOUT) -> Any:

@@ -45,6 +45,7 @@ from action_msgs.msg import GoalStatus, GoalStatusArray
 from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosgraph_msgs.msg import Clock
 
+from acti_bringup.serving.adapter import CLIENT_QOS
 from acti_bringup.serving.spinning import init, stop_requested
 
 ARM, BASE = "/acti_middle_node/", "/vehicle_node/"
@@ -112,7 +113,7 @@ class Background:
 
     def send(self, srv_type: type, name: str, **fields: Any) -> Any:
         client = self._clients.get(name) or self._clients.setdefault(
-            name, self.node.create_client(srv_type, name))
+            name, self.node.create_client(srv_type, name, qos_profile=CLIENT_QOS))
         assert client.wait_for_service(timeout_sec=30.0)
         return client.call_async(srv_type.Request(**fields))
 

@@ -182,11 +182,9 @@ def test_every_goal_of_a_burst_is_answered(ros, job):
     """20 goals sent at once: each is answered, the bound's worth accepted and the rest rejected
     (the goal service kept rclpy's 10 requests: the others had no answer at all)."""
     from rclpy.action import ActionClient
-    from rclpy.qos import QoSProfile
+    from acti_bringup.serving.adapter import CLIENT_ACTION_QOS
     arm_id = arm_long_motion(ros)
-    deep = QoSProfile(depth=100)
-    client = ActionClient(ros.node, WaitMotion, ARM + "wait_motion", goal_service_qos_profile=deep,
-                          result_service_qos_profile=deep)
+    client = ActionClient(ros.node, WaitMotion, ARM + "wait_motion", **CLIENT_ACTION_QOS)
     try:
         assert client.wait_for_server(timeout_sec=30.0)
         futures = [client.send_goal_async(WaitMotion.Goal(motion_id=arm_id)) for _ in range(20)]

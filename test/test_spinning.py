@@ -197,3 +197,38 @@ def test_a_refused_start_up_setting_is_one_line_and_exit_status_2(tmp_path, modu
     fatal = [line for line in log.splitlines() if "[FATAL]" in line]
     assert len(fatal) == 1 and f"[{module}]: cannot start:" in fatal[0] and words in fatal[0], log
     assert "Traceback" not in log, log
+
+
+def test_a_busy_client_keeps_its_answer_among_answers_to_other_clients(ros, events_loop):
+    """DDS hands every response of a service to every client of it. A client that does not take
+    while another client gets 30 answers loses its own with rclpy's history of 10, and keeps it
+    with the harness's (CLIENT_QOS): why a storm of clients cost a busy client its answer."""
+    from rclpy.executors import SingleThreadedExecutor
+    node, loop = events_loop
+
+    def ping(_request, response):
+        response.success = True
+        return response
+    node.create_service(Trigger, "~/ping", ping)
+    loop.start()
+    name = "/spin_loop_test/ping"
+    kept = ros.node.create_client(Trigger, name, qos_profile=ros.client_qos)
+    shallow = ros.node.create_client(Trigger, name)
+    other = ros.rclpy.create_node("other_client")
+    others = SingleThreadedExecutor()
+    others.add_node(other)
+    busy = other.create_client(Trigger, name)
+    try:
+        assert all(c.wait_for_service(timeout_sec=30.0) for c in (kept, shallow, busy))
+        mine = [kept.call_async(Trigger.Request()), shallow.call_async(Trigger.Request())]
+        for _ in range(30):                    # answered while the test client does not take
+            future = busy.call_async(Trigger.Request())
+            others.spin_until_future_complete(future, timeout_sec=10.0)
+            assert future.done()
+        assert ros.spin_until(lambda: mine[0].done(), 10.0) and mine[0].result().success
+        assert not ros.spin_until(lambda: mine[1].done(), 1.0)
+    finally:
+        others.shutdown()
+        for client in (kept, shallow):
+            ros.node.destroy_client(client)
+        other.destroy_node()

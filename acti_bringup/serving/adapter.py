@@ -58,8 +58,15 @@ StatusWriter = Callable[[Any, Reply], None]
 # of clients can push a starved client's response out of it before that client acknowledged it,
 # and a response the transport dropped (a full receive queue) can then never be repaired: that
 # client waits for ever. A deeper history keeps every response until its client has it.
+# The same holds for a client: DDS delivers every response of a service to every client of it
+# (each keeps only its own), so a client that keeps rclpy's 10 loses its answer when more than
+# 10 answers to other clients arrive before it takes it — a busy client under a storm of others.
+# The harness's clients (tests, benchmarks) keep 100 (CLIENT_QOS); a user's busy client should too.
 SERVICE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
                          reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE)
+CLIENT_QOS = SERVICE_QOS
+CLIENT_ACTION_QOS = {f"{kind}_service_qos_profile": CLIENT_QOS
+                     for kind in ("goal", "result", "cancel")}
 
 
 def action_server(host: Node, action_type: Any, name: str, execute: Callable,
