@@ -62,3 +62,21 @@ def test_an_unchanged_reply_is_answered_with_the_response_that_carried_it():
     limits["soft_limit"] = LIMITS
     again = ask()
     assert again is not first and [(v.upper, v.lower) for v in again.soft_limit] == LIMITS
+
+
+def test_a_reply_key_is_the_same_for_the_same_values_in_any_container_and_none_without_one():
+    """The memo's key: lists, tuples and arrays of the same numbers give the same key, other
+    numbers another, a None value is a value, and a value with no hashable copy gives no key
+    (such a reply is never answered from the memo)."""
+    import numpy as np
+    from acti_bringup.serving.conversions import reply_key
+    key = reply_key(0, "", {"soft_limit": LIMITS, "n": 1})
+    assert key == reply_key(0, "", {"soft_limit": [list(x) for x in LIMITS], "n": 1})
+    assert key == reply_key(0, "", {"soft_limit": np.array(LIMITS), "n": 1})
+    assert hash(key) == hash(reply_key(0, "", {"soft_limit": tuple(LIMITS), "n": 1}))
+    assert key != reply_key(0, "", {"soft_limit": [(170.0, -170.0), (121.0, -120.0)], "n": 1})
+    assert key != reply_key(-3, "", {"soft_limit": LIMITS, "n": 1})
+    assert key != reply_key(0, "why", {"soft_limit": LIMITS, "n": 1})
+    assert reply_key(0, "", {"a": None}) == (0, "", (("a", None),))
+    assert reply_key(0, "", {"a": {"b": 1}}) is None
+    assert reply_key(0, "", {"a": [1, {"b": 1}]}) is None

@@ -15,7 +15,7 @@ from rclpy.action import ActionServer
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-from acti_bringup.serving.conversions import fill, frozen, request_reader
+from acti_bringup.serving.conversions import fill, reply_key, request_reader
 from acti_motion.replies import Reply, ReturnCode
 
 @dataclass(frozen=True)
@@ -110,7 +110,7 @@ def _handler(node: Node, op: Operation, method: Callable[..., Reply],
         nonlocal last
         try:
             reply = method(**read(request))
-            key = frozen((reply.code, reply.comment, tuple(reply.values.items())))
+            key = reply_key(reply.code, reply.comment, reply.values)
             if key is not None and key == last[0]:
                 return last[1]
             write_status(response, reply)

@@ -158,7 +158,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     def get_feedback_pos_joint(self) -> dict:
         """Measured J1 … J7 (degree), then the gripper axis as its opening (mm)."""
         opening_mm = 2000.0 * self._finger
-        return {"pos": [*np.degrees(self._feedback), opening_mm]}
+        return {"pos": [*np.degrees(self._feedback).tolist(), opening_mm]}
 
     @returns(*GETTER)
     def get_manip_info(self) -> Reply:
@@ -187,7 +187,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
 
     @returns(*GETTER)
     def get_soft_limit_joint(self) -> dict:
-        return {"soft_limit": [(float(hi), float(lo)) for lo, hi in self.soft_limit_joint]}
+        return {"soft_limit": [(hi, lo) for lo, hi in self.soft_limit_joint.tolist()]}
 
     @returns(R.STATUS_ERR, R.VALUE_ERR)
     def set_soft_limit_joint(self, soft_limit: list) -> None:
@@ -232,7 +232,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
 
     @returns(*GETTER)
     def get_max_speed_joint(self) -> dict:
-        return {"speed": [float(v) for v in self.max_speed_joint]}
+        return {"speed": self.max_speed_joint.tolist()}
 
     @returns(*GETTER)
     def get_min_accel_time_cartesian(self) -> dict:
@@ -244,12 +244,12 @@ class ArmCore(SoftLimitWatch, MovePlanning):
 
     @returns(*GETTER)
     def get_soft_limit_cartesian(self) -> dict:
-        return {f"{a}_limit": (float(hi), float(lo))
-                for a, (lo, hi) in zip("xyz", self.soft_limit_cartesian)}
+        return {f"{a}_limit": (hi, lo)
+                for a, (lo, hi) in zip("xyz", self.soft_limit_cartesian.tolist())}
 
     @returns(*GETTER)
     def get_home(self) -> dict:
-        return {"joint_point": [float(v) for v in self.home]}
+        return {"joint_point": self.home.tolist()}
 
     # === middle-level port: settings ==============================================================
     @returns(*SETTER)
