@@ -11,6 +11,7 @@ from acti_msgs import srv
 from acti_msgs.msg import CarPosWithElbow
 
 N = 200
+BLOCKS = 4        # the N alternations of a call: in this many blocks, spread over the run
 IDENTITY = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
 ARM = "/acti_middle_node/"
 ARM_START = (0.0, 45.0, 0.0, -90.0, 0.0, 45.0, 0.0)
@@ -43,9 +44,10 @@ def accept_latency() -> None:
         pairs = paired(bare_call(ros), [
             ("get_state while moving", lambda: ros.call(srv.GetState, ARM + "get_state")),
             ("move_ptp_joint_rel accept", ptp),
-            ("move_linear_cartesian_rel (20 mm) accept", cp)], N, warmup=10)
+            ("move_linear_cartesian_rel (20 mm) accept", cp)], N, warmup=10, rounds=BLOCKS)
         moving = ros.call(srv.GetState, ARM + "get_state").state & 0x02
-    table(f"round trip over DDS, {N} alternations (bare, call) for each call, arm moving: "
+    table(f"round trip over DDS, {N} alternations (bare, call) for each call in {BLOCKS} blocks "
+          f"spread over the run, arm moving: "
           f"{bool(moving)} (real time; goals: PTP accept <= 1.5, CP accept <= 3)", pairs,
           "bare Trigger")
     ros.close()

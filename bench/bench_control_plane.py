@@ -15,7 +15,8 @@ arrived. Ratios are against the bare round trip and the control period measured 
 the same run (the /clock increment). Goals: stop reply p99 <= 3x bare, rest within the decel
 time + 2 control periods, /clock never silent for more than 2 control periods. A trial whose
 call went unanswered is counted as lost, beside the UDP datagrams the kernel dropped at full
-socket receive buffers meanwhile (what loses calls under a storm: `net.core.rmem_default`).
+socket receive buffers meanwhile (a client keeping fewer responses than the answers to other
+clients that arrive before it takes its own loses it: the harness's keep 100, `CLIENT_QOS`).
 
     python bench/bench_control_plane.py            (a few minutes)
     python bench/bench_control_plane.py --cases cd (only cases (c) and (d))

@@ -74,17 +74,27 @@ def against(baseline: tuple[str, Callable[[], object]], measured: Calls) -> Call
 Pairs = dict[str, tuple[np.ndarray, np.ndarray]]
 
 
-def paired(baseline: Callable[[], object], measured: Calls, n: int, warmup: int = 30) -> Pairs:
-    """Each measured call in a block of its own, alternating with the baseline (A B A B …, then
-    A C A C …): name -> (the baseline's sample, the call's sample) of that block. Both calls of
+def paired(baseline: Callable[[], object], measured: Calls, n: int, warmup: int = 30,
+           rounds: int = 1) -> Pairs:
+    """Each measured call in blocks of its own, alternating with the baseline (A B A B …, then
+    A C A C …): name -> (the baseline's samples, the call's samples) of its blocks. Both calls of
     a block are equally warm; in one round through many services (A B A C A D …) each service
     is called once in 2k calls and the baseline every other call, which weighs the caches'
-    coldness (the client's as much as the server's) on the measured side only."""
-    out: Pairs = {}
-    for name, fn in measured:
-        block = interleaved([("baseline", baseline), (name, fn)], n, warmup)
-        out[name] = (block["baseline"], block[name])
-    return out
+    coldness (the client's as much as the server's) on the measured side only.
+
+    With `rounds` > 1 the n alternations of each call are split into that many blocks, one per
+    pass through all the calls, and pooled: the same call's ratio moved by ±0.07 from one block
+    to the next (how the machine's threads happened to fall on its cores for a few seconds), so
+    one block per call made the worst of many calls mostly the unluckiest block."""
+    out: dict[str, tuple[list[np.ndarray], list[np.ndarray]]] = {name: ([], []) for name, _ in measured}
+    for r in range(rounds):
+        for name, fn in measured:
+            block = interleaved([("baseline", baseline), (name, fn)],
+                                n // rounds + (r < n % rounds), warmup)
+            out[name][0].append(block["baseline"])
+            out[name][1].append(block[name])
+    return {name: (np.concatenate(base), np.concatenate(sample))
+            for name, (base, sample) in out.items()}
 
 
 def p(sample: np.ndarray, q: float) -> float:
@@ -105,12 +115,12 @@ def row(name: str, sample: np.ndarray, baseline: np.ndarray | None = None) -> st
 
 
 def table(title: str, pairs: Pairs, baseline: str) -> None:
-    """Print each measured call against the baseline sample of its own block (and the baseline's
+    """Print each measured call against the baseline samples of its own blocks (and the baseline's
     samples pooled)."""
     print(title)
     print(f"(bare baseline: std_srvs/Trigger on rclpy's {BARE_EXECUTOR} executor, the kind the "
           f"nodes' control plane runs on; client waits with its own spin_once loop; each call "
-          f"in its own block, alternating with the baseline)")
+          f"in blocks of its own, alternating with the baseline)")
     print(row(baseline, np.concatenate([base for base, _ in pairs.values()])))
     for name, (base, sample) in pairs.items():
         print(row(name, sample, base))
