@@ -84,7 +84,7 @@ def paired(baseline: Callable[[], object], measured: Calls, n: int, warmup: int 
 
     With `rounds` > 1 the n alternations of each call are split into that many blocks, one per
     pass through all the calls, and pooled: the same call's ratio moved by ±0.07 from one block
-    to the next (how the machine's threads happened to fall on its cores for a few seconds), so
+    to the next (the machine as it was for those few seconds), so
     one block per call made the worst of many calls mostly the unluckiest block."""
     out: dict[str, tuple[list[np.ndarray], list[np.ndarray]]] = {name: ([], []) for name, _ in measured}
     for r in range(rounds):
