@@ -7,6 +7,8 @@ import time
 import numpy as np
 from common import RosClient, bare_call, paired, running, simulated_arm, table
 
+from bench.trigger_server import REPLAY
+
 from acti_msgs import srv
 from acti_msgs.msg import CarPosWithElbow
 
@@ -26,30 +28,42 @@ def accept_latency() -> None:
         # a long first move keeps the arm moving while the others queue behind it
         ros.call(srv.MovePTPJointRel, ARM + "move_ptp_joint_rel", joint_points=[60.0] + [0.0] * 6)
         ros.spin_until(lambda: ros.call(srv.GetState, ARM + "get_state").state & 0x02, 5.0)
-        sign = {"ptp": 1.0, "cp": 1.0}     # each kind goes back and forth: no drift
+        sign: dict[str, float] = {}     # each kind, on each server, goes back and forth: no drift
 
-        def ptp():
-            sign["ptp"] = -sign["ptp"]
-            r = ros.call(srv.MovePTPJointRel, ARM + "move_ptp_joint_rel",
-                         joint_points=[0.5 * sign["ptp"]] * 7)
+        def flip(key: str) -> float:
+            sign[key] = -sign.get(key, -1.0)
+            return sign[key]
+
+        def ptp(prefix: str = "") -> None:
+            r = ros.call(srv.MovePTPJointRel, prefix + ARM + "move_ptp_joint_rel",
+                         joint_points=[0.5 * flip("ptp" + prefix)] * 7)
             assert r.return_id.id == 0, r.return_id.comment
 
-        def cp():
-            sign["cp"] = -sign["cp"]
+        def cp(prefix: str = "") -> None:
             m = list(IDENTITY)
-            m[3] = 20.0 * sign["cp"]
-            r = ros.call(srv.MoveLinearCartesianRel, ARM + "move_linear_cartesian_rel",
+            m[3] = 20.0 * flip("cp" + prefix)
+            r = ros.call(srv.MoveLinearCartesianRel, prefix + ARM + "move_linear_cartesian_rel",
                          car_point=CarPosWithElbow(car_pos=m))
             assert r.return_id.id == 0, r.return_id.comment
-        pairs = paired(bare_call(ros), [
-            ("get_state while moving", lambda: ros.call(srv.GetState, ARM + "get_state")),
-            ("move_ptp_joint_rel accept", ptp),
-            ("move_linear_cartesian_rel (20 mm) accept", cp)], N, warmup=10, rounds=BLOCKS)
+
+        def state(prefix: str = "") -> None:
+            ros.call(srv.GetState, prefix + ARM + "get_state")
+        calls = {"get_state while moving": state, "move_ptp_joint_rel accept": ptp,
+                 "move_linear_cartesian_rel (20 mm) accept": cp}
+        pairs = paired(bare_call(ros), list(calls.items()), N, warmup=10, rounds=BLOCKS)
+        with running("bench.trigger_server",
+                     args=("replay", *(ARM + op for op in ("get_state", "move_ptp_joint_rel",
+                                                         "move_linear_cartesian_rel")))):
+            same = paired({name: lambda fn=fn: fn(REPLAY) for name, fn in calls.items()},
+                          list(calls.items()), N, warmup=10, rounds=BLOCKS)
         moving = ros.call(srv.GetState, ARM + "get_state").state & 0x02
     table(f"round trip over DDS, {N} alternations (bare, call) for each call in {BLOCKS} blocks "
           f"spread over the run, arm moving: "
           f"{bool(moving)} (real time; goals: PTP accept <= 1.5, CP accept <= 3)", pairs,
           "bare Trigger")
+    table("the same calls against a bare server that answers the same messages at once "
+          "(a move: OK, nothing planned): the node's own cost, the plan's among it", same,
+          "bare replay", "the same service types")
     ros.close()
 
 

@@ -3,7 +3,9 @@ std_srvs/Trigger server: get_state and every getter of both nodes, each in block
 alternating with the baseline (bare, getter, bare, getter …), one block per getter in each of
 BLOCKS passes through them all, pooled; then one round through all of
 them (bare, getter 1, bare, getter 2 …, every service cold); then the main job's CPU use while
-idle (over 20 s, 3 s after the last call)."""
+idle (over 20 s, 3 s after the last call); last, every getter against a bare server answering
+the same reply (`trigger_server.py replay`): the ROS layer's own cost, without the larger
+message's conversions that the Trigger baseline leaves in."""
 import time
 
 import numpy as np
@@ -11,15 +13,11 @@ import numpy as np
 from common import (RosClient, against, bare_call, idle_cpu_percent, interleaved, p, paired,
                     running, table, worst_ratios)
 
-from acti_middle_node.operations import OPERATIONS as ARM_OPERATIONS
-from vehicle_node.operations import OPERATIONS as BASE_OPERATIONS
+from bench.trigger_server import GETTERS, REPLAY
 
 N = 500
 BLOCKS = 5       # the N alternations of a getter: in this many blocks, spread over the run
 ROUNDS = 100
-GETTERS = [(f"/{node}/{op.name}", op.srv_type)
-           for node, ops in (("acti_middle_node", ARM_OPERATIONS), ("vehicle_node", BASE_OPERATIONS))
-           for op in ops if op.name.startswith("get_")]
 
 
 def main() -> None:
@@ -30,6 +28,10 @@ def main() -> None:
         rounds = interleaved(against(("bare Trigger", bare_call(ros)), getters), ROUNDS)
         time.sleep(3.0)          # the calls' tail (DDS acknowledgements, collections) ends
         cpu = idle_cpu_percent(job.proc.pid, seconds=20.0)
+        with running("bench.trigger_server", args=("replay",)):
+            replays = {name: lambda s=srv_type, n=name: ros.call(s, REPLAY + n)
+                       for name, srv_type in GETTERS}
+            same = paired(replays, getters, N, rounds=BLOCKS)
     table(f"round trip over DDS, {N} alternations (bare, getter) for each of {len(GETTERS)} "
           f"getters in {BLOCKS} blocks spread over the run; main job idle, simulation at real "
           "time", pairs, "bare Trigger")
@@ -45,6 +47,13 @@ def main() -> None:
           f"each service called once in {2 * len(GETTERS)} calls, cold): p50 ratios "
           f"{cold[0]:.2f} … {cold[-1]:.2f}, median {cold[len(cold) // 2]:.2f}")
     print(f"main job (python -m acti_bringup) idle CPU: {cpu:.1f} % of one core   (goal <= 10 %)")
+    table(f"the same getters against a bare server answering the same reply, {N} alternations "
+          f"each in {BLOCKS} blocks", same, "bare replay", "each getter's reply")
+    same_p50 = sorted(p(s, 50) / p(base, 50) for base, s in same.values())
+    p50, p99 = worst_ratios(same)
+    print(f"vs a bare node answering the same messages: median getter p50 "
+          f"{np.median(same_p50):.2f}, worst p50 {p50:.2f}  p99 {p99:.2f}; "
+          f"{sum(r <= 1.3 for r in same_p50)} of {len(same_p50)} getters <= 1.3")
     ros.close()
 
 

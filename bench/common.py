@@ -74,10 +74,11 @@ def against(baseline: tuple[str, Callable[[], object]], measured: Calls) -> Call
 Pairs = dict[str, tuple[np.ndarray, np.ndarray]]
 
 
-def paired(baseline: Callable[[], object], measured: Calls, n: int, warmup: int = 30,
-           rounds: int = 1) -> Pairs:
+def paired(baseline: Callable[[], object] | dict[str, Callable[[], object]], measured: Calls,
+           n: int, warmup: int = 30, rounds: int = 1) -> Pairs:
     """Each measured call in blocks of its own, alternating with the baseline (A B A B …, then
-    A C A C …): name -> (the baseline's samples, the call's samples) of its blocks. Both calls of
+    A C A C …), or with its own baseline where `baseline` maps each call's name to one:
+    name -> (the baseline's samples, the call's samples) of its blocks. Both calls of
     a block are equally warm; in one round through many services (A B A C A D …) each service
     is called once in 2k calls and the baseline every other call, which weighs the caches'
     coldness (the client's as much as the server's) on the measured side only.
@@ -89,7 +90,8 @@ def paired(baseline: Callable[[], object], measured: Calls, n: int, warmup: int 
     out: dict[str, tuple[list[np.ndarray], list[np.ndarray]]] = {name: ([], []) for name, _ in measured}
     for r in range(rounds):
         for name, fn in measured:
-            block = interleaved([("baseline", baseline), (name, fn)],
+            base = baseline[name] if isinstance(baseline, dict) else baseline
+            block = interleaved([("baseline", base), (name, fn)],
                                 n // rounds + (r < n % rounds), warmup)
             out[name][0].append(block["baseline"])
             out[name][1].append(block[name])
@@ -114,11 +116,11 @@ def row(name: str, sample: np.ndarray, baseline: np.ndarray | None = None) -> st
     return text
 
 
-def table(title: str, pairs: Pairs, baseline: str) -> None:
+def table(title: str, pairs: Pairs, baseline: str, serves: str = "std_srvs/Trigger") -> None:
     """Print each measured call against the baseline samples of its own blocks (and the baseline's
-    samples pooled)."""
+    samples pooled); `serves`: what the bare server answers."""
     print(title)
-    print(f"(bare baseline: std_srvs/Trigger on rclpy's {BARE_EXECUTOR} executor, the kind the "
+    print(f"(bare baseline: {serves} on rclpy's {BARE_EXECUTOR} executor, the kind the "
           f"nodes' control plane runs on; client waits with its own spin_once loop; each call "
           f"in blocks of its own, alternating with the baseline)")
     print(row(baseline, np.concatenate([base for base, _ in pairs.values()])))

@@ -1,10 +1,18 @@
-"""Baseline for the round-trip benchmarks: a bare std_srvs/Trigger server, nothing behind it.
+"""Baselines for the round-trip benchmarks: bare servers, nothing behind them.
 
 Served the way the nodes serve their control plane (`acti_bringup.serving.spinning`: an EventsExecutor
 driven by a spin_once loop), so the ratio measures the nodes' own cost, not an executor choice:
 
-    python -m bench.trigger_server [events|single|multi]
-"""
+    python -m bench.trigger_server [events|single|multi]   a std_srvs/Trigger, /bare_trigger/trigger
+    python -m bench.trigger_server replay [SERVICE ...]    the services named (default: every getter
+                                                           of both nodes) as /bare_replay/<node>/<op>:
+                                                           a getter answers the reply the running main
+                                                           job gave it once, any other operation an
+                                                           OK reply (motion id 1) and does nothing
+
+The replay server tells a call's cost over a bare node answering the same messages (what the
+ROS layer and, for a move, its plan cost) apart from its cost over a Trigger (which adds the
+larger messages' own conversions at both ends)."""
 import sys
 
 import rclpy
@@ -13,23 +21,59 @@ from rclpy.experimental import EventsExecutor
 from std_srvs.srv import Trigger
 
 from acti_bringup.serving.spinning import SpinLoop, init, wait_for_signal
+from acti_middle_node.operations import OPERATIONS as ARM_OPERATIONS
+from vehicle_node.operations import OPERATIONS as BASE_OPERATIONS
 
 EXECUTORS = {"events": EventsExecutor, "single": SingleThreadedExecutor,
              "multi": MultiThreadedExecutor}
 KIND = "events"
+REPLAY = "/bare_replay"
+SERVICES = {f"/{node}/{op.name}": op.srv_type
+            for node, ops in (("acti_middle_node", ARM_OPERATIONS), ("vehicle_node", BASE_OPERATIONS))
+            for op in ops}
+GETTERS = [(name, srv_type) for name, srv_type in SERVICES.items()
+           if name.rsplit("/", 1)[1].startswith("get_")]
 
 
-def main() -> None:
-    args = rclpy.utilities.remove_ros_args(sys.argv)
-    kind = args[1] if len(args) > 1 else KIND
-    init(sys.argv)
+def trigger_node() -> rclpy.node.Node:
     node = rclpy.create_node("bare_trigger")
 
     def answer(_req, resp):
         resp.success = True
         return resp
     node.create_service(Trigger, "~/trigger", answer)
-    executor = EXECUTORS[kind]()
+    return node
+
+
+def replay_node(names: list[str]) -> rclpy.node.Node:
+    """The services `names`, each answering one reply: a getter's fetched once from the running
+    job, another operation's an OK reply that accepted nothing."""
+    from acti_bringup.harness import RosClient
+    fetch = RosClient("bare_replay_fetch")
+    replies = {}
+    for name in names:
+        srv_type = SERVICES[name]
+        if name.rsplit("/", 1)[1].startswith("get_"):
+            replies[name] = fetch.call(srv_type, name)
+        else:
+            replies[name] = srv_type.Response()
+            replies[name].motion_id = 1
+    fetch.close()
+    node = rclpy.create_node("bare_replay")
+    for name in names:
+        node.create_service(SERVICES[name], REPLAY + name, lambda _req, _resp, r=replies[name]: r)
+    return node
+
+
+def main() -> None:
+    args = rclpy.utilities.remove_ros_args(sys.argv)
+    kind = args[1] if len(args) > 1 else KIND
+    init(sys.argv)
+    if kind == "replay":
+        node = replay_node(args[2:] or [name for name, _ in GETTERS])
+    else:
+        node = trigger_node()
+    executor = EXECUTORS[KIND if kind == "replay" else kind]()
     executor.add_node(node)
     loop = SpinLoop(executor, "bare").start()
     try:
