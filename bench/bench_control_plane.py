@@ -11,7 +11,9 @@ source timestamp of the response: the stop is in force when the job answers, so 
 out the request's way to the job, which a storm lengthens in this client's process); and, as
 a third figure, when the goal's result reached this client (which adds this client's own
 delays: a storm takes both cores from it too). /clock gaps likewise: as the job sent them and as they
-arrived. Ratios are against the bare round trip and the control period measured in
+arrived, beside the largest silence of a bare process that only publishes a Clock every control
+period, scheduled as the job's loop (`clock_floor.py`): what the machine allowed in that case.
+Ratios are against the bare round trip and the control period measured in
 the same run (the /clock increment). Goals: stop reply p99 <= 3x bare, rest within the decel
 time + 2 control periods, /clock never silent for more than 2 control periods. A trial whose
 call went unanswered is counted as lost, beside the UDP datagrams the kernel dropped at full
@@ -47,6 +49,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosgraph_msgs.msg import Clock
 
 from acti_bringup.serving.adapter import CLIENT_QOS
+from bench.clock_floor import FIFO_PRIORITY, TOPIC as BARE_CLOCK
 from acti_bringup.serving.spinning import init, stop_requested
 
 ARM, BASE = "/acti_middle_node/", "/vehicle_node/"
@@ -89,6 +92,10 @@ class Background:
         self.clock_sent: list[float] = []           # by the job (DDS source timestamp, wall)
         self.clock_values: list[float] = []
         self.node.create_subscription(Clock, "/clock", self._on_clock, 100)
+        self.bare_clock_sent: list[float] = []      # by the bare publisher (source timestamp)
+        self.node.create_subscription(
+            Clock, BARE_CLOCK,
+            lambda _m, info: self.bare_clock_sent.append(info["source_timestamp"] * 1e-9), 100)
         # when the job declared each goal of ~/wait_motion ended (DDS source timestamp, wall)
         self.goal_ended: dict[bytes, float] = {}
         status_qos = QoSProfile(depth=100, durability=DurabilityPolicy.TRANSIENT_LOCAL)
@@ -118,17 +125,21 @@ class Background:
         assert client.wait_for_service(timeout_sec=30.0)
         return client.call_async(srv_type.Request(**fields))
 
-    def largest_clock_gaps(self, since: float, until: float) -> tuple[float, float]:
+    def largest_clock_gaps(self, since: float, until: float) -> tuple[float, float, float]:
         """The largest gap between two /clock messages as the job sent them (their DDS source
         timestamps: the job's own silence) and as they arrived here (adding this client's
-        delays: a storm takes both cores from it too)."""
+        delays: a storm takes both cores from it too); and the bare publisher's largest silence
+        between the first and the last of those source timestamps."""
         n = len(self.clock_sent)                     # both lists grow on the spin thread
         arrived = np.array(self.clock_arrivals[:n])
         inside = (arrived >= since) & (arrived <= until)
         if inside.sum() < 2:
-            return float("inf"), float("inf")
+            return float("inf"), float("inf"), float("inf")
         sent = np.array(self.clock_sent[:n])[inside]
-        return float(np.max(np.diff(sent))), float(np.max(np.diff(arrived[inside])))
+        bare = np.array(self.bare_clock_sent[:len(self.bare_clock_sent)])
+        bare = bare[(bare >= sent[0]) & (bare <= sent[-1])]
+        bare_gap = float(np.max(np.diff(bare))) if len(bare) > 1 else float("inf")
+        return float(np.max(np.diff(sent))), float(np.max(np.diff(arrived[inside]))), bare_gap
 
     def control_period(self) -> float:
         return float(np.median(np.diff(np.array(self.clock_values[-500:]))))
@@ -212,6 +223,7 @@ class Figures:
     rest_answered: list[float]   # the job answered stop → it said the wait ended (both stamps)
     clock_gap: float     # the job's largest /clock silence (source timestamps)
     clock_arrival_gap: float     # ... as seen by this client
+    bare_clock_gap: float        # the bare publisher's largest silence meanwhile
     lost: list[str]      # the step each lost trial timed out in
 
 
@@ -250,17 +262,18 @@ def running_motion(ros: RosClient, device: Device, waiter: Actions,
 
 def run_trials(ros: RosClient, bg: Background, device: Device, load: Load,
                waiter: Actions) -> Figures:
-    f = Figures([], [], [], [], [], 0.0, 0.0, [])
+    f = Figures([], [], [], [], [], 0.0, 0.0, 0.0, [])
     for trial in range(-1, TRIALS):                     # trial -1 warms up (lazy imports)
         if trial == 0:
-            f, t0 = Figures([], [], [], [], [], 0.0, 0.0, []), time.monotonic()
+            f, t0 = Figures([], [], [], [], [], 0.0, 0.0, 0.0, []), time.monotonic()
         try:
             trial_figures(ros, bg, device, load, waiter, trial, f)
         except TimeoutError as e:
             f.lost.append(str(e))
             print(f"  {device.name} trial {trial}: {e}", file=sys.stderr, flush=True)
             ros.call(device.stop_srv, device.path + "stop")
-    f.clock_gap, f.clock_arrival_gap = bg.largest_clock_gaps(t0, time.monotonic())
+    f.clock_gap, f.clock_arrival_gap, f.bare_clock_gap = bg.largest_clock_gaps(
+        t0, time.monotonic())
     return f
 
 
@@ -417,8 +430,9 @@ def main(cases: str) -> None:
               f"queue_size:={QUEUE}", "rate_hz:=250.0", "clock_rate_hz:=250.0",
               # the control loop under SCHED_FIFO (opt-in): without it the base's planning held
               # /clock back 9-14 ms in cases (a)-(c)
-              "control_fifo_priority:=10")
-    with running("bench.trigger_server"), running("acti_bringup", *params):
+              f"control_fifo_priority:={FIFO_PRIORITY}")
+    with running("bench.trigger_server"), running("bench.clock_floor"), \
+            running("acti_bringup", *params):
         bg = Background()
         prepare(ros)
         assert ros.spin_until(lambda: len(bg.clock_values) > 100, 30.0), "no /clock"
@@ -449,7 +463,8 @@ def main(cases: str) -> None:
                           f" {p(np.array(f.rest), 99):12.1f}"
                           f" {f.clock_gap * 1e3:7.1f} "
                           f"({f.clock_gap / period:.1f} periods; {f.clock_arrival_gap * 1e3:.1f}"
-                          f" as it arrived)" + lost_text(f.lost, drops))
+                          f" as it arrived; bare {f.bare_clock_gap * 1e3:.1f})"
+                          + lost_text(f.lost, drops))
         bg.close()
     ros.close()
 
