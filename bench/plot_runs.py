@@ -1,4 +1,4 @@
-"""Figures for the README from real runs on the simulation (the cores on their own world, no ROS):
+"""Figures for docs/performance.md from real runs on the simulation (the cores on their own world, no ROS):
 
   docs/cp_move.png  a CP move through the wrist singularity: the control point's measured speed
                     along the path, the planned speed and the TOPP-RA time-optimal bound

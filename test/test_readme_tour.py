@@ -1,4 +1,4 @@
-"""The README's quick tour, then its examples of the arm's actions and of a robot program, pasted
+"""The README's quick tour, then the examples of the arm's actions and of a robot program in docs/, pasted
 in order into bash against the main job, work: every service call is answered with success,
 every goal and program ends well, the jog and the echo run.
 
@@ -15,15 +15,19 @@ robot = node_fixture("acti_bringup")
 TOUR_TIMEOUT_S = 240      # below the suite's 300 s per test: a hang shows its output
 
 
-PASTED = ("## Quick tour", "### acti_middle_node actions and topics", "## Robot programs")
+PASTED = (("README.md", "## Quick tour"), ("docs/interfaces.md", "## acti_middle_node actions and topics"),
+          ("docs/programs.md", "## Robot programs"))
+
+
+def first_bash_block(path: str, heading: str) -> str:
+    with open(os.path.join(ROOT, path), encoding="utf-8") as f:
+        text = f.read()
+    return text.split(f"\n{heading}\n", 1)[1].split("```bash\n", 1)[1].split("```", 1)[0]
 
 
 def quick_tour() -> str:
     """The first bash block under each heading of PASTED, the endless commands bounded."""
-    with open(os.path.join(ROOT, "README.md"), encoding="utf-8") as f:
-        readme = f.read()
-    block = "".join(readme.split(f"\n{heading}\n", 1)[1].split("```bash\n", 1)[1].split("```", 1)[0]
-                    for heading in PASTED)
+    block = "".join(first_bash_block(path, heading) for path, heading in PASTED)
     block = re.sub(r"^ros2 topic pub ", "ros2 topic pub -t 10 ", block, flags=re.M)
     return re.sub(r"^ros2 topic echo ", "ros2 topic echo --once ", block, flags=re.M)
 

@@ -61,7 +61,7 @@ def stop_requested() -> bool:
 
 
 USAGE_TAIL = ("ROS arguments: --ros-args -r __ns:=/robot1 -p name:=value "
-              "--params-file config/acti_ros2.yaml (README.md: Parameters)")
+              "--params-file config/acti_ros2.yaml (docs/interfaces.md: Parameters)")
 
 
 MAX_DOMAIN_ID = 232     # Fast DDS: 7400 + 250 × domain + offsets must stay a UDP port

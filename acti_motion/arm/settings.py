@@ -17,7 +17,7 @@ from acti_motion.arm.poses import hg_to_pose
 from acti_motion.config_fields import QUEUE_SIZE_RANGE, check_ranges, ranged
 from acti_motion.replies import Refused, ReturnCode, finite_number, value_error
 
-# Bounds of the settings that keep the arm stoppable and every plan quick (README: arm settings).
+# Bounds of the settings that keep the arm stoppable and every plan quick (docs/interfaces.md: acti_middle_node services).
 # A stop decelerates over the running move's accel time, so an accel time of minutes is a
 # misconfiguration, not a setting; speeds below the minimums would time a move over days.
 MAX_ACCEL_TIME_S = 10.0
