@@ -59,9 +59,10 @@ $(DEPS_STAMP): $(BUILD_DEPS_STAMP) requirements.txt
 	touch $@
 
 # Python sources need no rebuild: --symlink-install runs them from the tree. Our tf2_msgs
-# (msg_defs/tf2_msgs) is added only where no tf2_msgs is installed (tools/own_tf2_msgs.py).
-$(BUILD_STAMP): $(BUILD_DEPS_STAMP) $(INTERFACES) package.xml setup.py setup.cfg tools/own_tf2_msgs.py
-	$(ENV) && $(BUILD_ENV) colcon --log-base log build $(COLCON_PATHS) $$(python tools/own_tf2_msgs.py) \
+# (msg_defs/tf2_msgs) and control_msgs (msg_defs/control_msgs) are added only where none is
+# installed (tools/own_msgs.py).
+$(BUILD_STAMP): $(BUILD_DEPS_STAMP) $(INTERFACES) package.xml setup.py setup.cfg tools/own_msgs.py
+	$(ENV) && $(BUILD_ENV) colcon --log-base log build $(COLCON_PATHS) $$(python tools/own_msgs.py) \
 	  --symlink-install --parallel-workers $(NPROC) --cmake-args $(CMAKE_ARGS)
 	touch $@
 
