@@ -16,9 +16,17 @@ ESCAPES = {b: f"\\x{b:02x}" for b in range(256) if b not in PRINTABLE}   # str.t
 ELEMENTS_AT_ONCE = 4096      # array elements formatted together (a huge array is no huge list)
 
 
+EXACT_INTEGERS_BELOW = 2.0 ** 53    # integral reals of this size print every digit as it is
+
+
 def format_real32(value: float) -> str:
-    """The shortest decimal that reads back as the same single-precision value."""
-    return str(np.float32(value))
+    """The shortest decimal that reads back as the same single-precision value, except for an
+    integral value whose shortest form names another integer: I4 33554437 × R4 2.5 is R4
+    83886088 (Annex 1 §5), whose shortest form 8.388609e+07 read as 83886090."""
+    text = str(np.float32(value))
+    if value.is_integer() and abs(value) < EXACT_INTEGERS_BELOW and float(text) != value:
+        return f"{int(value)}.0"
+    return text
 
 
 def format_number(num: Num, typed: bool = True) -> str:

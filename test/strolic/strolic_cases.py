@@ -50,14 +50,15 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
             ("R4:1.5 I4:33554433 SUB", ["R4:-3.355443e+07"])],          # 1.5 − 33554432
     "MUL": [("6 7 MUL", ["42"]), ("I2:300 300 MUL", OVF), ("I4:300 300 MUL", ["90000"]),
             ("R4:1.5 2 MUL", ["R4:3.0"]), ("1e-200 1e-200 MUL", UNF), ("1e200 1e200 MUL", OVF),
-            ("I4:16777217 R4:3.0 MUL", ["R4:5.033165e+07"])],           # 16777216 × 3
+            ("I4:16777217 R4:3.0 MUL", ["R4:50331648.0"]),            # 16777216 × 3
+            ("I4:33554437 R4:2.5 MUL", ["R4:83886088.0"])],             # 33554436 × 2.5, in R4
     "DIV": [("7 2 DIV", ["3.5"]), ("R4:1.0 4 DIV", ["0.25"]), ("1 0 DIV", DIV0),
             ("1.0 0.0 DIV", DIV0), ("I4:16777217 R4:1.0 DIV", ["16777216.0"]),
             ("I4:16777217 1.0 DIV", ["16777217.0"])],
     "PWR": [("2 3 PWR", ["8"]), ("2 10 PWR", OVF), ("I2:2 10 PWR", ["1024"]),
             ("2.0 0.5 PWR", ["1.4142135623730951"]), ("R4:2.0 3 PWR", ["R4:8.0"]),
             ("0 0 PWR", ["1"]), ("2 -1 PWR", DIV0), ("-8.0 0.5 PWR", UNDEF),
-            ("I4:16777217 R4:2.0 PWR", ["R4:2.8147498e+14"])],          # 2^48
+            ("I4:16777217 R4:2.0 PWR", ["R4:281474976710656.0"])],          # 2^48
     "MOD": [("7 3 MOD", ["1"]), ("-7 3 MOD", ["-1"]), ("7 -3 MOD", ["1"]), ("-7 -3 MOD", ["-1"]),
             ("I2:7 3 MOD", ["I2:1"]), ("7 0 MOD", DIV0), ("7.0 3 MOD", TYPE)],
     "IDIV": [("7 2 IDIV", ["3"]), ("-7 2 IDIV", ["-3"]), ("7 -2 IDIV", ["-3"]),
@@ -148,7 +149,7 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
     "VTIMES": [("Vec(1 2 3) 2 VTIMES", ["Vec(2.0 4.0 6.0)"]),
                ("Vec(1 2 3) R4:0.5 VTIMES", ["Vec(0.5 1.0 1.5)"]),
                ("Vec(1 2 3) 1e300 VTIMES", OVF), ("2 Vec(1 2 3) VTIMES", TYPE),
-               ("Vec(0 0 3) I4:16777217 VTIMES", ["Vec(0.0 0.0 5.033165e+07)"])],  # I4 → R4
+               ("Vec(0 0 3) I4:16777217 VTIMES", ["Vec(0.0 0.0 50331648.0)"])],  # I4 → R4
     "VPRODI": [("Vec(1 2 3) Vec(4 5 6) VPRODI", ["R4:32.0"])],
     "VPRODO": [("Vec(1 0 0) Vec(0 1 0) VPRODO", ["Vec(0.0 0.0 1.0)"]),
                ("Vec(0 1 0) Vec(1 0 0) VPRODO", ["Vec(0.0 0.0 -1.0)"])],
@@ -246,6 +247,8 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
     "BRT": [("#f Fn{ 1 >a BRT 1 a: 2 END } STORE f", ["2"]),
             ("#f Fn{ 2 >a BRT 1 a: 2 END } STORE f", ["2"]),
             ("#f Fn{ 0 >a BRT 1 a: 2 END } STORE f", ["1", "2"]),
+            ("#f Fn{ -1 >a BRT 1 a: 2 END } STORE f", ["2"]),          # Annex 1 §7: ≠ 0 is true
+            ("#f Fn{ -0.5 >a BRT 1 a: 2 END } STORE f", ["2"]),
             ("#f Fn{ 1 50 BRT END } STORE f", BRANCH), ("1 5 BRT 1", ["1"])],
     "RET": [("#f Fn{ 1 RET 2 END } STORE f 3", ["1", "3"]), ("RET", K.NO_RETURN_DESTINATION)],
     "END": [("#f Fn{ 1 END } STORE f f", ["1", "1"]), ("END 1", ["1"]),
@@ -260,7 +263,9 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
                ("#x 1 STORE 1 NESTIN VAR #x DCL #x 2 STORE 1 NESTIN x NESTOUT x", ["1", "2"]),
                ("-1 NESTIN", UNDEF),
                (" ".join(["1 NESTIN"] * 40), K.STACK_OVERFLOW)],
-    "NESTOUT": [("1 NESTIN VAR #%2000 DCL NESTOUT #%2000 PUSH", UNDEF), ("NESTOUT 1", ["1"])],
+    "NESTOUT": [("1 NESTIN VAR #%2000 DCL NESTOUT #%2000 PUSH", UNDEF), ("NESTOUT 1", ["1"]),
+                # at the outermost level it does nothing: the globals stay, twice over
+                ("#x 1 STORE NESTOUT NESTOUT x", ["1"])],
     "NPUSH": [("#x 1 STORE 1 NESTIN VAR #x DCL #x 2 STORE #x 0 NPUSH #x 1 NPUSH", ["1", "2"]),
               ("#x 5 NPUSH", UNDEF), ("1 NESTIN #x 1 NPUSH", UNDEF)],
     "NPOP": [("#x 1 STORE 1 NESTIN VAR #x DCL 9 #x 0 NPOP NESTOUT x", ["9"]),

@@ -59,6 +59,27 @@ def test_data_stack_and_return_stack_overflow() -> None:
     assert error_of("#f Fn{ f END } STORE f", max_return_depth=50).kind is K.STACK_OVERFLOW
 
 
+# f calls (one return-stack entry), BALs to s (one more) and s BALs to itself x times.
+NESTED_BALS = ("#f Fn{ >s BAL END s: x >done BRF #x x DEC STORE >s BAL done: RET END } STORE "
+               "#x %d STORE f x")
+
+
+def test_the_return_stack_holds_exactly_its_limit_of_bal_entries() -> None:
+    """max_return_depth entries fit (the call and 1 + 8 BALs in 10), one more overflows: a
+    limit off by one either way fails one of the two."""
+    assert stack_of(NESTED_BALS % 8, max_return_depth=10) == ["0"]
+    error = error_of(NESTED_BALS % 9, max_return_depth=10)
+    assert (error.kind, error.function.split()[0]) == (K.STACK_OVERFLOW, "BAL")
+
+
+def test_gret_clears_the_return_stack() -> None:
+    """After GRET inside a BAL subroutine the input stream goes on (5) and has nothing to
+    return to: a RET there is the exception, not a jump to the BAL's left-over entry."""
+    gret_in_subroutine = "#g Fn{ >s BAL 2 END s: GRET END } STORE g "
+    assert stack_of(gret_in_subroutine + "5") == ["5"]
+    assert error_of(gret_in_subroutine + "RET").kind is K.NO_RETURN_DESTINATION
+
+
 DOUBLINGS = " ".join(["DUP CONC"] * 28)           # 8 bytes → 2 GiB in 28 instructions
 
 
