@@ -146,6 +146,18 @@ class Device:
         """Nothing runs or waits to run: the loop has nothing to command it."""
         return self.current is None and not self.queue
 
+    def motion_state(self) -> tuple[bool, bool, bool]:
+        """(moving, paused, full), read together under the lock, so that a state word made of
+        them is one moment's: read apart, a stop between two reads made a paused arm at rest
+        look moving. Moving: the current motion's clock runs or is to run (its rate, or the
+        rate it ramps to, is above 0: a motion paused or stopped at rest is not moving), or a
+        motion waits to start and no pause holds it."""
+        with self.lock:
+            cur = self.current
+            moving = (self.rate > 0.0 or self._rate_target > 0.0) if cur is not None \
+                else bool(self.queue) and not self.paused
+            return moving, self.paused, len(self.queue) >= self.capacity
+
     def submit(self, plan: Callable[[Any], Motion], label: str) -> int | None:
         """Plan a motion from the end of the last queued one and append it; its id, or None when
         the queue is full (`submit_all` of one)."""
@@ -413,11 +425,36 @@ class Device:
             except Exception as e:
                 self._fail(e, t0)
 
+    def _next_rate(self, dt: float) -> float:
+        """The rate after one more step of `dt`: it ramps linearly towards its target."""
+        r0 = self.rate
+        step = dt / self._ramp if self._ramp > 0 else 1.0
+        return min(self._rate_target, r0 + step) if r0 < self._rate_target \
+            else max(self._rate_target, r0 - step)
+
+    def rest_time_after_next_step(self, ramp: float, dt: float) -> float:
+        """The current motion's clock time where it would rest if a stop over `ramp` seconds
+        began after the next step (clock and rate then, as `stop` computes the rest point):
+        what the watch looks ahead to. Called on the simulation thread, the one that advances
+        the clock and the rate, so they are read together."""
+        cur = self.current
+        if cur is None:
+            return self.t
+        r1 = self._next_rate(dt)
+        t1 = self.t + dt * (self.rate + r1) / 2
+        return min(cur.motion.duration, t1 + r1 * r1 * ramp / 2)
+
+    def stop_at(self, t_rest: float, shortest_ramp: float, reason: str = STOPPED) -> None:
+        """`stop` with the ramp that rests the current motion at clock time `t_rest`, or with
+        `shortest_ramp` when that rests it later (the fastest stop allowed)."""
+        r = self.rate
+        ramp = 2.0 * (t_rest - self.t) / (r * r) if r > 0.0 else shortest_ramp
+        self.stop(max(ramp, shortest_ramp), reason)
+
     def _advance(self, world: World, dt: float) -> None:
         """One step of the current motion: ramp the rate, advance its clock, command the world."""
         r0 = self.rate
-        step = dt / self._ramp if self._ramp > 0 else 1.0
-        r1 = min(self._rate_target, r0 + step) if r0 < self._rate_target else max(self._rate_target, r0 - step)
+        r1 = self._next_rate(dt)
         self.rate = r1
         self.t += dt * (r0 + r1) / 2
         cur = self.current

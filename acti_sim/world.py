@@ -99,6 +99,7 @@ class World:
         self._wheel_ids = [self._joint[n] for n in WHEEL_JOINTS]
         self._sensed_ids = [*self._arm_ids, self._grip_ids[0], *self._wheel_ids]
         self._positions: list[float] | None = None
+        self._arm_speeds: list[float] = []
         self._movable = [j for j in self._joint.values()
                          if p.getJointInfo(self.robot, j)[2] != pybullet.JOINT_FIXED]
         self._movable_names = [p.getJointInfo(self.robot, j)[1].decode() for j in self._movable]
@@ -123,9 +124,12 @@ class World:
 
     def _sensed(self) -> list[float]:
         """Positions of the arm joints, the gripper finger and the wheels, read from PyBullet
-        once per state of the world (the cores sample all of them every step)."""
+        once per state of the world (the cores sample all of them every step), with the arm
+        joints' velocities (`_arm_speeds`)."""
         if self._positions is None:
-            self._positions = [s[0] for s in self._p.getJointStates(self.robot, self._sensed_ids)]
+            states = self._p.getJointStates(self.robot, self._sensed_ids)
+            self._positions = [s[0] for s in states]
+            self._arm_speeds = [s[1] for s in states[:len(self._arm_ids)]]
         return self._positions
 
     def render(self, eye: tuple[float, float, float], target: tuple[float, float, float],
@@ -183,7 +187,8 @@ class World:
         return np.array(self._sensed()[:len(self._arm_ids)])
 
     def arm_velocities(self) -> np.ndarray:
-        return np.array([s[1] for s in self._p.getJointStates(self.robot, self._arm_ids)])
+        self._sensed()
+        return np.array(self._arm_speeds)
 
     def set_gripper_target(self, finger: float) -> None:
         """Both fingers to `finger` metres from the centre (the URDF mimic, enforced here)."""

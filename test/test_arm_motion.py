@@ -245,8 +245,8 @@ def test_pause_while_stopping_is_ignored(arm, executor):  # noqa: F811
     run_until(executor, lambda: executor.world.time > 0.5, 2.0)
     assert arm.stop().ok
     assert arm.pause().comment == "ignored: it is stopping"
-    run_until(executor, lambda: not arm.device.busy, 1.0)
-    assert arm.state_word() == 0x01
+    run_until(executor, lambda: not arm.state_word() & 0x02, 1.0)
+    assert arm.state_word() == 0x01 and not arm.device.busy
     assert arm.move_ptp_joint_rel([1.0] * 7).ok
     assert run_until(executor, lambda: not arm.device.busy, 2.0) > 0.2
     trace.check()
@@ -295,10 +295,32 @@ def test_cartesian_soft_limit_crossed_while_moving_stops_with_alarm_5(arm, execu
     r = arm.move_ptp_joint_rel([1.0] * 7)
     assert r.code == R.STATUS_ERR
     assert arm.stop().comment == "ignored: an alarm is active"
+    run_until(executor, lambda: not arm.state_word() & 0x02, 0.2)     # the joints settled
     assert arm.clear_alarms().ok and arm.state_word() == 0x01
     assert arm.move_linear_cartesian_rel(rel(dx=-50.0)).ok        # back inside: allowed
     rest(executor, arm)
     assert not arm.alarms
+    trace.check()
+
+
+def test_servo_off_during_a_soft_limit_stop_keeps_its_braking(arm, executor):  # noqa: F811
+    """servo_off stops at the motion's accel time (1 s here); during the alarm's fastest stop
+    that must not lengthen the braking (it ended 95.8 mm past the limit instead of 15.8)."""
+    trace = ArmTrace(executor, arm)
+    arm.set_speed_cartesian(100)
+    assert arm.set_accel_time_cartesian(1.0).ok
+    P0, _ = feedback(arm)
+    x0 = P0[0, 3] * 1000
+    assert arm.move_linear_cartesian_rel(rel(dx=250.0)).ok
+    run_until(executor, lambda: arm.device.rate >= 1.0 and arm.device.t > 1.0, 5.0)
+    x_now = arm.tool_pose(arm.device.current.motion.at(arm.device.t).joints)[0, 3] * 1000
+    limit = x_now + 30.0
+    assert arm.set_soft_limit_cartesian((limit, -1000.0), (1000.0, -1000.0), (1600.0, -100.0)).ok
+    run_until(executor, lambda: arm.alarms, 5.0)
+    executor.step()
+    assert arm.device.stopping and arm.servo_off().ok
+    run_until(executor, lambda: not arm.device.busy, 3.0)
+    assert arm.tool_pose(arm.device.hold.joints)[0, 3] * 1000 <= limit + 1e-3
     trace.check()
 
 
@@ -317,6 +339,33 @@ def test_joint_soft_limit_narrowed_while_paused_raises_alarm_4_on_resume(arm, ex
     assert arm.alarms[0].code == 0x4 and "J1" in arm.alarms[0].description
     run_until(executor, lambda: not arm.device.busy, 1.0)
     assert arm.get_active_alarm().values["alarms"][0][:2] == (0x4, 1)
+    # the watch looked ahead by the braking distance: the arm rests at the limit (was 0.876°
+    # past it), commanded and measured
+    assert abs(math.degrees(arm.device.hold.joints[0]) - (j1 + 5.0)) < 1e-3
+    run_until(executor, lambda: not arm.state_word() & 0x02, 1.0)
+    assert arm.get_feedback_pos_joint().values["pos"][0] <= j1 + 5.0 + 0.01
+    trace.check()
+
+
+def test_a_cartesian_soft_limit_set_while_moving_stops_the_arm_at_it(arm, executor):  # noqa: F811
+    """The limit is 60 mm ahead of a 200 mm line at full speed: the stop begins a braking
+    distance before it, and the control point rests on it (was: the stop began at the
+    crossing and ended past it)."""
+    trace = ArmTrace(executor, arm)
+    arm.set_speed_cartesian(100)
+    P0, _ = feedback(arm)
+    x0 = P0[0, 3] * 1000
+    assert arm.move_linear_cartesian_rel(rel(dx=200.0)).ok
+    run_until(executor, lambda: arm.device.current is not None, 0.1)
+    assert arm.set_soft_limit_cartesian((x0 + 60.0, -1000.0), (1000.0, -1000.0),
+                                        (1600.0, -100.0)).ok
+    run_until(executor, lambda: arm.alarms, 5.0)
+    assert arm.alarms[0].code == 0x5 and "x =" in arm.alarms[0].description
+    run_until(executor, lambda: not arm.device.busy, 2.0)
+    rest_x = arm.tool_pose(arm.device.hold.joints)[0, 3] * 1000
+    assert x0 + 59.9 <= rest_x <= x0 + 60.0 + 1e-3
+    run_until(executor, lambda: not arm.state_word() & 0x02, 1.0)
+    assert feedback(arm)[0][0, 3] * 1000 <= x0 + 60.0 + 0.1
     trace.check()
 
 

@@ -229,8 +229,8 @@ def test_servo_off_keeps_bit_0x01_until_the_arm_is_at_rest(arm, executor, trace)
     assert arm.servo_off().ok
     assert arm.move_ptp_joint_rel([1.0] * 7).code == R.NOT_SV_ON_ERR    # refused at once
     words = []
-    run_until(executor, lambda: words.append(arm.state_word()) or not arm.device.busy, 2.0)
-    assert all(w & SERVO for w in words[:-1]) and words[-1] == 0
+    run_until(executor, lambda: words.append(arm.state_word()) or words[-1] == 0, 2.0)
+    assert all(w & SERVO for w in words[:-1]) and words[-1] == 0 and not arm.device.busy
     trace.check()
 
 
@@ -399,3 +399,39 @@ def test_a_move_sent_before_a_stop_and_planned_after_it_is_discarded(arm, execut
     assert b.ok and arm.device.was_discarded(b.values["motion_id"]), b
     steps(executor, 250)
     assert not arm.device.busy and np.allclose(arm.device.hold.joints, start)
+
+
+# --- the state word: one moment's ------------------------------------------------------------------
+@pytest.mark.parametrize("halt", ["stop", "servo_off"])
+def test_a_paused_arm_at_rest_is_not_moving_right_after_stop_or_servo_off(arm, executor, halt):  # noqa: F811
+    """Was 0x03 until the next control period: the stop cleared the pause, and the word, read
+    in parts, saw a current motion without the pause that held it at rest."""
+    assert arm.move_ptp_joint_rel([20.0] * 7).ok
+    steps(executor, 60)
+    assert arm.pause().ok
+    run_until(executor, lambda: arm.state_word() == SERVO | PAUSED, 2.0)
+    assert getattr(arm, halt)().ok
+    word = arm.state_word()                           # before the simulation steps again
+    assert not word & MOVING and word == (SERVO if halt == "stop" else 0)
+    steps(executor, 3)
+    assert arm.state_word() == (SERVO if halt == "stop" else 0) and not arm.device.busy
+
+
+def test_the_moving_bit_lasts_while_the_measured_joints_move(arm, executor):  # noqa: F811
+    """After a stop the set-point rests, and the joints follow it for a few control periods
+    more: the word said not moving (and, after servo_off, 0x00) while they still moved."""
+    from acti_motion.arm.watch import SETTLED_DEG_S
+    assert arm.move_ptp_joint_rel([30.0] * 7).ok
+    steps(executor, 80)
+    assert arm.stop().ok
+    tail = []                     # (device busy, measured speed °/s, word) each period after
+    for _ in range(200):
+        executor.step()
+        speed = float(np.degrees(np.abs(executor.world.arm_velocities())).max())
+        tail.append((arm.device.busy, speed, arm.state_word()))
+        if not tail[-1][2] & MOVING:
+            break
+    assert all(word & MOVING for busy, speed, word in tail if busy or speed > SETTLED_DEG_S)
+    settling = [speed for busy, speed, word in tail if not busy and word & MOVING]
+    assert settling and settling[0] > SETTLED_DEG_S      # the tail this covers exists
+    assert tail[-1][2] == SERVO and tail[-1][1] <= SETTLED_DEG_S

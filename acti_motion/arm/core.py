@@ -103,6 +103,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
         self._feedback = world.arm_positions()
         self._measured = (world.time, self._feedback)
         self._finger = world.gripper_position()
+        self._settling = False
         self.device = executor.add_device("arm", c.queue_size,
                                           ArmSetpoint(q0.copy(), self._finger))
         self._apply_settings(c)
@@ -519,17 +520,21 @@ class ArmCore(SoftLimitWatch, MovePlanning):
 
     # === state, feedback and progress (also for the node's topics and actions) =====================
     def state_word(self) -> int:
-        d = self.device
-        # after servo_off the axes stay powered until the decelerating stop is at rest
-        word = STATE_SERVO_ON if self.servo or d.current is not None else 0
-        if d.current is not None and not (d.paused and d.rate <= 0.0) \
-                or d.current is None and d.queue and not d.paused:
+        """The state word of one moment: the device's motion state read together
+        (`Device.motion_state`) and the joints as the last control period measured them. Moving
+        (0x02) while a motion runs or waits unpaused, or while the measured joints still settle
+        onto a set-point at rest (a stop's tail: they move for tens of ms after it); after
+        servo_off the axes stay powered (0x01) until then."""
+        moving, paused, full = self.device.motion_state()
+        moving = moving or self.settling
+        word = STATE_SERVO_ON if self.servo or moving else 0
+        if moving:
             word |= STATE_MOVING
         if self._alarms:
             word |= STATE_ALARM
-        if d.full:
+        if full:
             word |= STATE_BUFFER_FULL
-        if d.paused:
+        if paused:
             word |= STATE_PAUSED
         return word
 
@@ -570,8 +575,10 @@ class ArmCore(SoftLimitWatch, MovePlanning):
             raise Refused(R.STATUS_ERR, f"the speed ratio is 0 %: set it with {setter} first")
 
     def _check_idle(self, name: str) -> None:
-        """The spec refuses these while moving (state bit 0x02) or alarmed; paused is not moving."""
-        if self.state_word() & STATE_MOVING:
+        """The spec refuses these while moving or alarmed; paused is not moving. Moving is the
+        motion's (`Device.motion_state`): the joints settling onto a set-point at rest, which
+        the state word shows too, run no plan that a setting could change."""
+        if self.device.motion_state()[0]:
             raise Refused(R.STATUS_ERR, f"{name} is refused while the arm moves "
                                         "(wait, pause or stop first)")
         if self._alarms:
@@ -592,11 +599,5 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     def stop_motion(self, fastest: bool = False, reason: str = STOPPED) -> None:
         """Stop at the motion's accel time (or the fastest the settings allow); `reason` is
         what a wait on a discarded motion is told."""
-        cur = self.device.current
-        if fastest:
-            ramp = (self.min_accel_time_cartesian
-                    if cur is not None and cur.motion.kind == "cartesian"
-                    else self.min_accel_time_joint)
-        else:
-            ramp = self.current_ramp()
+        ramp = self._fastest_ramp(self.device.current) if fastest else self.current_ramp()
         self.device.stop(ramp, reason)

@@ -271,10 +271,11 @@ class RobotHost(Host):
     def wait_at_rest(self) -> None:
         """After a stop: until the arm is at rest, so that a run ends with the robot stopped
         (§4.5) and its client can start again at once (a canceled run answered while the arm
-        still decelerated, and the next program's first move was discarded by that stop)."""
+        still decelerated, and the next program's first move was discarded by that stop), its
+        joints settled (the state word says not moving)."""
         device, executor = self.arm.device, self.arm.executor
         deadline = time.monotonic() + REST_TIMEOUT_S
-        while device.stopping and time.monotonic() < deadline:
+        while (device.stopping or self.arm.settling) and time.monotonic() < deadline:
             if self.step is not None:
                 self.step()
             elif executor.running:
