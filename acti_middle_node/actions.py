@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Callable, TypeVar
 
 from acti_msgs.action import Move, WaitMotion
 from acti_msgs.msg import ReturnId
@@ -19,6 +19,8 @@ from acti_bringup.serving.waiting import GoalSlots, accept_cancel, device_watch,
 from acti_motion.arm.core import ArmCore
 from acti_motion.replies import Reply, ReturnCode
 from acti_motion.config_fields import GOALS_RANGE, RATE_RANGE_HZ, ranged
+
+T = TypeVar("T")
 
 # Move.Goal.kind → the core operation and the goal fields it takes (core name ← goal field).
 MOVE_KINDS: dict[str, tuple[tuple[str, str], ...]] = {
@@ -90,7 +92,7 @@ class MotionActions:
                                                 + ", ".join(MOVE_KINDS))
         else:
             kwargs = {name: to_core(getattr(goal, field)) for name, field in fields}
-            reply = await self._off_plane(lambda: getattr(self.core, goal.kind)(**kwargs))
+            reply = await self.off_plane(lambda: getattr(self.core, goal.kind)(**kwargs))
         result.return_id = return_id(reply)
         if not reply.ok:
             goal_handle.abort()
@@ -131,8 +133,9 @@ class MotionActions:
             goal_handle.abort()
         return result
 
-    async def _off_plane(self, move: Callable[[], Reply]) -> Reply:
-        """move() (a core operation: it answers, never raises) on the goals' planning thread,
+    async def off_plane(self, move: Callable[[], T]) -> T:
+        """move() (a core operation, or anything that answers and never raises) on the goals'
+        planning thread (the trajectory and gripper goals use it too),
         awaited without holding the goal plane's one thread: a move plans for milliseconds and
         waits for any plan under way (the accept lock) for as long as that takes, and every
         other goal's acceptance, feedback, cancel and result waited with it. One thread, so

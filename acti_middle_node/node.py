@@ -1,5 +1,7 @@
 """ArmNode: the thin ROS adapter of `acti_motion.arm.core.ArmCore`: the operation table's services,
-the ~/wait_motion, ~/move and ~/run_program (STROLIC) actions, and the ~/state topic."""
+the ~/wait_motion, ~/move and ~/run_program (STROLIC) actions, the ~/state topic, and the
+controllers MoveIt drives (arm_controller/…, gripper_controller/…: see trajectory_controller and
+gripper_controller)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -13,8 +15,10 @@ from acti_bringup.serving.parameters import Setting, declare_config, sync_parame
 from acti_bringup.serving.spinning import steady_timer, warn_of_namesakes
 from acti_bringup.simulation import Simulation, stamp
 from acti_middle_node.actions import ActionConfig, MotionActions
+from acti_middle_node.gripper_controller import GripperConfig, GripperController
 from acti_middle_node.operations import OPERATIONS
 from acti_middle_node.program_action import ProgramAction
+from acti_middle_node.trajectory_controller import ControllerConfig, TrajectoryController
 from acti_motion.arm.core import ArmConfig, ArmCore
 from acti_motion.arm.poses import quaternion_xyzw
 from acti_motion.replies import Reply
@@ -65,6 +69,11 @@ class ArmNode(Node):
         self.actions = MotionActions(self.goals, self.core, actions)
         self.programs = ProgramAction(self.goals, self.core, actions.feedback_rate_hz,
                                       declare_config(self, ProgramDefaults))
+        self.trajectories = TrajectoryController(
+            self.goals, self.motion, self.core, declare_config(self, ControllerConfig),
+            self.actions.off_plane, program_running=lambda: not self.programs.idle)
+        self.gripper = GripperController(self.goals, self.core, declare_config(self, GripperConfig),
+                                         self.actions.off_plane)
         self._state = self.create_publisher(ArmState, "~/state", 10)
         warn_of_namesakes(self, self._state)
         steady_timer(self, 1.0 / topics.state_rate_hz, self._publish_state)

@@ -100,7 +100,7 @@ def four_points(step=0.2, dt=1.0):
 
 def test_a_trajectory_runs_as_one_motion_and_ends_at_its_last_point(executor, arm):  # noqa: F811
     follower = ArmTrajectories(arm)
-    motion_id = follower.follow(validate(four_points(), ARM_JOINTS, follower.now()), "t")
+    motion_id, _ = follower.follow(validate(four_points(), ARM_JOINTS, follower.now()), "t")
     assert arm.device.current is None and arm.device.queue[0].id == motion_id
     executor.step()
     assert arm.state_word() & 0x02                              # moving, in the state word
@@ -131,7 +131,7 @@ def test_a_first_point_away_from_the_arm_is_refused(executor, arm):  # noqa: F81
 
 def test_stop_pause_and_busy_govern_it(executor, arm):  # noqa: F811
     follower = ArmTrajectories(arm)
-    motion_id = follower.follow(validate(four_points(), ARM_JOINTS, follower.now()), "t")
+    motion_id, _ = follower.follow(validate(four_points(), ARM_JOINTS, follower.now()), "t")
     run_until(executor, lambda: arm.device.t > 0.5, 5.0)
     assert arm.pause().ok
     run_until(executor, lambda: arm.device.rate == 0.0, 5.0)
@@ -152,11 +152,11 @@ def test_stop_pause_and_busy_govern_it(executor, arm):  # noqa: F811
 
 def test_a_new_trajectory_replaces_the_running_one(executor, arm):  # noqa: F811
     follower = ArmTrajectories(arm)
-    first = follower.follow(validate(four_points(0.3, 2.0), ARM_JOINTS, follower.now()), "t")
+    first, _ = follower.follow(validate(four_points(0.3, 2.0), ARM_JOINTS, follower.now()), "t")
     run_until(executor, lambda: arm.device.t > 1.0, 5.0)
     q = arm.device.current.motion.at(arm.device.t).joints
     back = RequestedTrajectory(list(ARM_JOINTS), [RequestedPoint(1.5, list(Q0), [0.0] * 7)])
-    second = follower.follow(validate(back, ARM_JOINTS, follower.now()), "u")
+    second, _ = follower.follow(validate(back, ARM_JOINTS, follower.now()), "u")
     assert second > first and arm.device.discard_reason(first) == PREEMPTED
     assert np.max(np.abs(arm.device.current.motion.at(arm.device.t).joints - q)) < 0.02
     rest(executor, arm)

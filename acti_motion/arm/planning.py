@@ -274,8 +274,11 @@ class MovePlanning:
         return self._submit(plan, label)
 
     def queue_gripper(self, ratio: int, label: str) -> dict:
+        return self.queue_gripper_to(self.finger_max * ratio / 100.0, label)
+
+    def queue_gripper_to(self, finger: float, label: str) -> dict:
+        """A gripper move of each finger to `finger` m from the centre (0 … finger_max)."""
         self._check_can_move()
-        finger = self.finger_max * ratio / 100.0
         speed = self.config.gripper_speed / 2000.0      # one finger, m/s
         ramp = self.min_accel_time_joint
 

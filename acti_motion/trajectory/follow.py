@@ -24,6 +24,7 @@ from acti_sim.world import ARM_JOINTS
 LOOKAHEAD_STEPS = 3          # a replacement takes over this many control periods ahead (first try)
 CARTESIAN_CHECK_S = 0.01     # the control point is checked against the Cartesian box this densely
 PREEMPTED = "preempted by a newer trajectory"
+PlanOf = Callable[[State, float], FollowPlan]
 
 
 class _Invalid(Refused):
@@ -68,31 +69,36 @@ class ArmTrajectories:
             return None
         return cur.motion
 
-    def follow(self, valid: ValidTrajectory, label: str) -> int:
-        """Queue the trajectory, or let it replace the one that runs; its motion id. Refused
-        (servo off, an alarm, the arm busy with ACT motions or a program) or InvalidTrajectory
-        (it breaks a limit, or does not start where the arm is) say why."""
+    def follow(self, valid: ValidTrajectory, label: str) -> tuple[int, TrajectoryMotion]:
+        """Queue the trajectory, or let it replace the one that runs; its motion id and motion.
+        Refused (servo off, an alarm, the arm busy with ACT motions or a program) or
+        InvalidTrajectory (it breaks a limit, or does not start where the arm is) say why."""
+        return self.follow_plan(
+            lambda start, now: follow_plan(valid, start, now, self.joints), label)
+
+    def follow_plan(self, plan_of: PlanOf, label: str) -> tuple[int, TrajectoryMotion]:
+        """`follow` for the knots plan_of(the arm's state where they begin, the time then)."""
         self.core._check_can_move()
         for _ in range(3):
             if self.running() is not None:
-                out = self.device.edit_planned(*self._replacement(valid, label))
+                out = self.device.edit_planned(*self._replacement(plan_of, label))
                 if out is not STALE:
                     return out
                 continue
+            planned: list[TrajectoryMotion] = []
             try:
-                reply = self.core._submit(self._from_rest(valid), label)
+                reply = self.core._submit(self._from_rest(plan_of, planned), label)
             except _Invalid as e:
                 raise e.invalid from None
             if isinstance(reply, Reply):            # accepted while a stop decelerates: doomed
                 raise Refused(ReturnCode.STATUS_ERR, reply.comment)
-            return reply["motion_id"]
+            return reply["motion_id"], planned[-1]
         raise Refused(ReturnCode.STATUS_ERR, "the arm changed faster than the trajectory could be "
                                              "planned: send it again")
 
-    def plan(self, valid: ValidTrajectory, start: State, now: float) -> PiecewisePolynomial:
+    def plan(self, plan_of: PlanOf, start: State, now: float) -> PiecewisePolynomial:
         """The interpolation from `start`, checked against every limit (InvalidTrajectory)."""
-        plan = follow_plan(valid, start, now, self.joints)
-        poly = check_limits(plan, self.limits())
+        poly = check_limits(plan_of(start, now), self.limits())
         self._check_cartesian(poly)
         return poly
 
@@ -103,15 +109,16 @@ class ArmTrajectories:
         positions = core.frames.tool_of(core.kin.flange_many(qs))[:, :3, 3] * 1000.0
         core._check_cartesian_positions(positions, "the trajectory")
 
-    def _from_rest(self, valid: ValidTrajectory) -> Callable[[ArmSetpoint], TrajectoryMotion]:
+    def _from_rest(self, plan_of: PlanOf, planned: list[TrajectoryMotion]) -> Callable[[ArmSetpoint], TrajectoryMotion]:
         def plan(start: ArmSetpoint) -> TrajectoryMotion:
             self._check_idle()
             rest = np.zeros_like(start.joints)
             try:
-                poly = self.plan(valid, State(start.joints, rest, rest), self.now())
+                poly = self.plan(plan_of, State(start.joints, rest, rest), self.now())
             except InvalidTrajectory as e:
                 raise _Invalid(e) from None
-            return TrajectoryMotion(poly, start.finger, self.core.accel_time_joint)
+            planned.append(TrajectoryMotion(poly, start.finger, self.core.accel_time_joint))
+            return planned[-1]
         return plan
 
     def _check_idle(self) -> None:
@@ -122,7 +129,7 @@ class ArmTrajectories:
             raise Refused(ReturnCode.STATUS_ERR, f"the arm is busy: {what}; a trajectory starts "
                                                  "only from an idle arm (wait, or stop first)")
 
-    def _replacement(self, valid: ValidTrajectory, label: str) -> tuple[Callable, Callable]:
+    def _replacement(self, plan_of: PlanOf, label: str) -> tuple[Callable, Callable]:
         """look and plan of `Device.edit_planned` for a trajectory replacing the running one."""
         core, dt = self.core, self.core.executor.dt
 
@@ -134,7 +141,7 @@ class ArmTrajectories:
 
         def plan(seen: tuple) -> Callable[[Device], object]:
             cur, t, start, now = seen
-            poly = self.plan(valid, start, now)
+            poly = self.plan(plan_of, start, now)
             limits = core._limit_rows()
 
             def commit(device: Device) -> object:
@@ -145,6 +152,6 @@ class ArmTrajectories:
                 motion.limits_checked = limits
                 new_id = device.renumber(cur, PREEMPTED)
                 cur.motion, cur.label = motion, label
-                return new_id
+                return new_id, motion
             return commit
         return look, plan

@@ -26,6 +26,11 @@ class TrajectoryMotion:
         self.limits_checked: np.ndarray | None = None   # the soft limits its plan was checked with
         self._state: tuple[float, State] | None = None
 
+    @property
+    def end(self) -> np.ndarray:
+        """Where it ends (the joints, rad)."""
+        return self.poly.knots[-1].positions
+
     def state(self, t: float) -> State:
         """The reference at motion time t: positions, velocities, accelerations."""
         cached = self._state
