@@ -117,3 +117,23 @@ def test_the_measurement_and_its_time_are_read_together(arm, executor):  # noqa:
         t, q = arm.measured()
         assert t == executor.world.time and q is arm.feedback_joints
         assert np.allclose(q, executor.world.arm_positions())
+
+
+@pytest.mark.parametrize("time_step", [1.0 / 240.0, 0.01])
+@pytest.mark.parametrize("setter", ["set_min_accel_time_joint", "set_min_accel_time_cartesian"])
+def test_the_minimum_accel_time_is_at_least_two_control_cycles(setter, time_step):
+    """Two cycles of the executor's period, whatever it is: exactly two is accepted, a hair
+    less (and one and a half) is VALUE_ERR, and the accepted floor is the one kept."""
+    from acti_motion.executor import MotionExecutor
+    from acti_sim.world import World
+    world = World(time_step=time_step)
+    try:
+        arm = ArmCore(MotionExecutor(world, real_time_factor=0.0))
+        floor = 2 * time_step
+        for below in (floor * (1 - 1e-9), 1.5 * time_step):
+            r = getattr(arm, setter)(below)
+            assert r.code == ReturnCode.VALUE_ERR and "two control cycles" in r.comment
+        assert getattr(arm, setter)(floor).ok
+        assert getattr(arm, setter.replace("set_", "get_"))().values["acl_time"] == floor
+    finally:
+        world.close()
