@@ -138,6 +138,25 @@ def long_goal(robot, travel=0.6, duration=8.0):
     return q0, handle
 
 
+def test_joint_states_carry_every_moving_urdf_joint_on_the_clock(robot):
+    """MoveIt's "complete current state": every non-fixed joint of the URDF, stamped with the
+    simulated time of /clock."""
+    import xml.etree.ElementTree as ET
+
+    from acti_sim.world import URDF_PATH
+    moving = {j.get("name") for j in ET.parse(URDF_PATH).getroot().findall("joint")
+              if j.get("type") != "fixed"}
+    got = []
+    sub = robot.ros.node.create_subscription(JointState, "/joint_states", got.append, 10)
+    try:
+        assert robot.until(lambda: got)
+        msg, now = got[-1], robot.sim_time
+        assert set(msg.name) == moving and len(msg.position) == len(msg.name)
+        assert abs(msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9 - now) < 1.0
+    finally:
+        robot.ros.node.destroy_subscription(sub)
+
+
 # --- MoveIt's part -------------------------------------------------------------------------------
 def test_a_four_point_trajectory_succeeds_on_time_and_on_target(robot):
     robot.ready()
