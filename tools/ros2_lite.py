@@ -1,16 +1,20 @@
-"""The few `ros2` commands this README uses, for a checkout without a full ROS install.
+"""The `ros2` commands a user of these nodes needs, for a checkout without a full ROS install.
 
 The `ros2` CLI is not on PyPI, so `make run` cannot install it; `tools/env.sh` puts this one on
-PATH only when no `ros2` is found. It covers `service call|list`, `topic pub|echo|list`,
-`action send_goal` and `param get|set|describe|list` with the real CLI's arguments and the same
-request syntax (a YAML mapping of the fields; integers are accepted for floating-point fields),
-over rclpy and DDS as any ROS 2 client. Anything else: install ROS 2 Jazzy and source it.
+PATH only when no `ros2` is found. It covers `service call|list|type|find`,
+`topic pub|echo|list|info|type|hz`, `action send_goal|list|info`, `node list|info`,
+`param get|set|describe|list|dump` and `interface list|package|show` with the real CLI's
+arguments, output and request syntax (a YAML mapping of the fields; integers are accepted for
+floating-point fields), over rclpy and DDS as any ROS 2 client, hiding the hidden names as it
+does. Ctrl-C and SIGTERM end a command as they end the real one: without a traceback, exit
+status 2 and 15. Anything else: install ROS 2 Jazzy and source it.
 """
 from __future__ import annotations
 
 import argparse
 import array
 import importlib
+import os
 import signal
 import sys
 import time
@@ -22,11 +26,14 @@ import yaml
 from rclpy.action import ActionClient
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.signals import SignalHandlerOptions
 
-DISCOVERY_TIMEOUT_S = 30.0
+import ros2_graph
+import ros2_interfaces
+
+DISCOVERY_TIMEOUT_S = ros2_graph.DISCOVERY_TIMEOUT_S
 MATCH_WAIT_S = 2.0
 TEARDOWN_S = 5             # s the DDS teardown may take after the command is done
-LIST_WAIT_S = 4.0          # s a `list` waits at least for discovery
 SEQUENCES = (list, tuple, array.array, np.ndarray)
 
 
@@ -122,17 +129,6 @@ def spin_until(node: Node, done: Callable[[], bool], timeout: float | None, what
         rclpy.spin_once(node, timeout_sec=0.1)
 
 
-def topic_type(node: Node, topic: str) -> str:
-    """The type of a topic someone publishes, as discovered."""
-    deadline = time.monotonic() + DISCOVERY_TIMEOUT_S
-    while time.monotonic() < deadline:
-        for name, types in node.get_topic_names_and_types():
-            if name == topic and types:
-                return types[0]
-        rclpy.spin_once(node, timeout_sec=0.1)
-    raise Usage(f"the topic {topic} does not appear (give its type)")
-
-
 # --- commands -------------------------------------------------------------------------------------
 def service_call(node: Node, a: argparse.Namespace) -> None:
     cls = interface(a.type)
@@ -167,7 +163,7 @@ def topic_pub(node: Node, a: argparse.Namespace) -> None:
 
 
 def topic_echo(node: Node, a: argparse.Namespace) -> None:
-    cls = interface(a.type or topic_type(node, a.topic))
+    cls = interface(a.type or _published_type(node, a.topic))
     got: list[Any] = []
 
     def on_message(msg: Any) -> None:
@@ -177,22 +173,12 @@ def topic_echo(node: Node, a: argparse.Namespace) -> None:
     spin_until(node, lambda: a.once and bool(got), None, a.topic)
 
 
-def listing(node: Node, names_and_types: Callable[[], list], show_types: bool) -> None:
-    """What discovery finds, once it has found no new node and no new name for MATCH_WAIT_S,
-    and not before LIST_WAIT_S: a new participant learns the others' nodes and endpoints over a
-    few seconds, longer on a busy machine (after 2 s, one list in five held only its own)."""
-    def seen() -> tuple[list, int]:
-        return names_and_types(), len(node.get_node_names_and_namespaces())
-    (found, nodes), start = seen(), time.monotonic()
-    settled_at = start
-    while (time.monotonic() - settled_at < MATCH_WAIT_S or time.monotonic() - start < LIST_WAIT_S) \
-            and time.monotonic() < start + DISCOVERY_TIMEOUT_S:
-        rclpy.spin_once(node, timeout_sec=0.1)
-        now, now_nodes = seen()
-        if (len(now), now_nodes) != (len(found), nodes):
-            (found, nodes), settled_at = (now, now_nodes), time.monotonic()
-    for name, types in sorted(found):
-        print(f"{name} [{', '.join(types)}]" if show_types else name)
+def _published_type(node: Node, topic: str) -> str:
+    """The type of a topic someone publishes, as discovered."""
+    types = ros2_graph.types_of(node, topic, node.get_topic_names_and_types)
+    if not types:
+        raise Usage(f"the topic {topic} does not appear (give its type)")
+    return types[0]
 
 
 def action_send_goal(node: Node, a: argparse.Namespace) -> None:
@@ -234,6 +220,9 @@ def _answer(node: Node, future: Any, what: str) -> Any:
 
 def param(node: Node, a: argparse.Namespace) -> None:
     client = _parameter_client(node, a.node)
+    if a.verb == "dump":
+        param_dump(node, client, a.node)
+        return
     if a.verb == "list":
         for name in sorted(_answer(node, client.list_parameters([], 0), a.node).result.names):
             print(f"  {name}")
@@ -263,21 +252,64 @@ def param(node: Node, a: argparse.Namespace) -> None:
               else f"Setting parameter failed: {result.reason}")
 
 
+def param_dump(node: Node, client: Any, target: str) -> None:
+    """Every parameter as a parameters file holds it (`--params-file` reads it back)."""
+    full = "/" + target.lstrip("/")
+    names = sorted(_answer(node, client.list_parameters([], 0), target).result.names)
+    values = _answer(node, client.get_parameters(names), target).values if names else []
+    tree: dict[str, Any] = {}
+    for name, value in zip(names, values):
+        *groups, leaf = name.split(".")
+        branch = tree
+        for group in groups:
+            branch = branch.setdefault(group, {})
+        branch[leaf] = as_plain(Parameter.from_parameter_msg(_named(name, value)).value)
+    print(yaml.dump({full: {"ros__parameters": tree}}, default_flow_style=False))
+
+
 def _named(name: str, value: Any) -> Any:
     from rcl_interfaces.msg import Parameter as ParameterMsg
     return ParameterMsg(name=name, value=value)
 
 
 # --- command line ---------------------------------------------------------------------------------
-def parser() -> argparse.ArgumentParser:
-    top = argparse.ArgumentParser(prog="ros2", description=__doc__.splitlines()[0])
-    groups = top.add_subparsers(dest="group", required=True)
-    service = groups.add_parser("service").add_subparsers(dest="verb", required=True)
+def _verbs(groups: Any, group: str) -> Any:
+    return groups.add_parser(group).add_subparsers(dest="verb", required=True)
+
+
+def _hidden(command: argparse.ArgumentParser, *names: str) -> None:
+    """The real CLI's option that includes hidden names, and `--include-hidden` for all."""
+    command.add_argument("--include-hidden", *names, dest="include_hidden", action="store_true")
+
+
+def _counted_list(verbs: Any, count: str, run: Callable, hidden: tuple[str, ...] | None) -> None:
+    command = verbs.add_parser("list")
+    command.add_argument("-t", "--show-types", action="store_true")
+    command.add_argument("-c", f"--count-{count}", action="store_true")
+    if hidden is not None:
+        _hidden(command, *hidden)
+    command.set_defaults(run=run)
+
+
+def _service_parsers(groups: Any) -> None:
+    service = _verbs(groups, "service")
     call = service.add_parser("call")
     call.add_argument("name"), call.add_argument("type"), call.add_argument("values", nargs="?")
     call.set_defaults(run=service_call)
-    _add_list(service, "get_service_names_and_types")
-    topic = groups.add_parser("topic").add_subparsers(dest="verb", required=True)
+    _counted_list(service, "services", ros2_graph.service_list, ("--include-hidden-services",))
+    kind = service.add_parser("type")
+    kind.add_argument("service_name"), _hidden(kind, "--include-hidden-services")
+    kind.set_defaults(run=lambda n, a: ros2_graph.print_types(n, a.service_name,
+                                                             n.get_service_names_and_types))
+    find = service.add_parser("find")
+    find.add_argument("service_type"), find.add_argument("-c", "--count-services",
+                                                         action="store_true")
+    _hidden(find, "--include-hidden-services")
+    find.set_defaults(run=ros2_graph.service_find)
+
+
+def _topic_parsers(groups: Any) -> None:
+    topic = _verbs(groups, "topic")
     pub = topic.add_parser("pub")
     pub.add_argument("topic"), pub.add_argument("type"), pub.add_argument("values", nargs="?")
     pub.add_argument("-r", "--rate", type=float, default=1.0)
@@ -288,48 +320,128 @@ def parser() -> argparse.ArgumentParser:
     echo.add_argument("topic"), echo.add_argument("type", nargs="?")
     echo.add_argument("--once", action="store_true")
     echo.set_defaults(run=topic_echo)
-    _add_list(topic, "get_topic_names_and_types")
-    action = groups.add_parser("action").add_subparsers(dest="verb", required=True)
+    _counted_list(topic, "topics", ros2_graph.topic_list, ("--include-hidden-topics",))
+    info = topic.add_parser("info")
+    info.add_argument("topic_name"), info.add_argument("-v", "--verbose", action="store_true")
+    info.set_defaults(run=ros2_graph.topic_info)
+    kind = topic.add_parser("type")
+    kind.add_argument("topic_name"), _hidden(kind, "--include-hidden-topics")
+    kind.set_defaults(run=lambda n, a: ros2_graph.print_types(n, a.topic_name,
+                                                             n.get_topic_names_and_types))
+    hz = topic.add_parser("hz")
+    hz.add_argument("topic_name")
+    hz.add_argument("-w", "--window", dest="window_size", type=int, default=ros2_graph.HZ_WINDOW)
+    hz.add_argument("--wall-time", dest="use_wtime", action="store_true")
+    hz.add_argument("--times", type=int, default=None,
+                    help="end after this many reports (this tool only; the real one runs on)")
+    hz.set_defaults(run=lambda n, a: ros2_graph.topic_hz(n, a, interface))
+
+
+def _action_parsers(groups: Any) -> None:
+    action = _verbs(groups, "action")
     send = action.add_parser("send_goal")
     send.add_argument("name"), send.add_argument("type"), send.add_argument("values")
     send.add_argument("-f", "--feedback", action="store_true")
     send.set_defaults(run=action_send_goal)
+    _counted_list(action, "actions", ros2_graph.action_list, None)
+    info = action.add_parser("info")
+    info.add_argument("action_name"), info.add_argument("-t", "--show-types", action="store_true")
+    info.add_argument("-c", "--count", action="store_true")
+    info.set_defaults(run=ros2_graph.action_info)
+
+
+def _node_parsers(groups: Any) -> None:
+    node = _verbs(groups, "node")
+    listed = node.add_parser("list")
+    listed.add_argument("-a", "--all", "--include-hidden", action="store_true")
+    listed.add_argument("-c", "--count-nodes", action="store_true")
+    listed.set_defaults(run=ros2_graph.node_list)
+    info = node.add_parser("info")
+    info.add_argument("node_name"), _hidden(info)
+    info.set_defaults(run=ros2_graph.node_info)
+
+
+def _interface_parsers(groups: Any) -> None:
+    verbs = _verbs(groups, "interface")
+    listed = verbs.add_parser("list")
+    package = verbs.add_parser("package")
+    package.add_argument("package_name")
+    for command in (listed, package):
+        command.add_argument("-m", "--only-msgs", action="store_true")
+        command.add_argument("-s", "--only-srvs", action="store_true")
+        command.add_argument("-a", "--only-actions", action="store_true")
+    listed.set_defaults(offline=ros2_interfaces.interface_list)
+    package.set_defaults(offline=ros2_interfaces.interface_package)
+    show = verbs.add_parser("show")
+    show.add_argument("type")
+    comments = show.add_mutually_exclusive_group()
+    comments.add_argument("--all-comments", action="store_true")
+    comments.add_argument("--no-comments", action="store_true")
+    show.set_defaults(offline=ros2_interfaces.interface_show)
+
+
+def parser() -> argparse.ArgumentParser:
+    top = argparse.ArgumentParser(prog="ros2", description=__doc__.splitlines()[0])
+    groups = top.add_subparsers(dest="group", required=True)
+    for add in (_service_parsers, _topic_parsers, _action_parsers, _node_parsers,
+                _interface_parsers):
+        add(groups)
     params = groups.add_parser("param")
-    params.add_argument("verb", choices=("get", "set", "describe", "list"))
+    params.add_argument("verb", choices=("get", "set", "describe", "list", "dump"))
     params.add_argument("node"), params.add_argument("name", nargs="?")
     params.add_argument("value", nargs="?")
     params.set_defaults(run=param)
     return top
 
 
-def _add_list(verbs: Any, names_and_types: str) -> None:
-    """`list [-t]` of a group: what node.<names_and_types>() finds."""
-    command = verbs.add_parser("list")
-    command.add_argument("-t", "--show-types", action="store_true")
-    command.set_defaults(run=lambda n, a: listing(n, getattr(n, names_and_types), a.show_types))
+class Terminated(Exception):
+    """SIGTERM came: the command ends as after Ctrl-C."""
+
+
+def _raise_terminated(_signum: int, _frame: Any) -> None:
+    raise Terminated()
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run one command. Exit status: 0 done, 1 refused or not found (one line on stderr), 2
+    Ctrl-C, 15 SIGTERM: the real CLI's."""
     args = parser().parse_args(argv)
-    rclpy.init()
-    node = rclpy.create_node(f"ros2_lite_{int(time.time() * 1000) % 100000}")
+    signal.signal(signal.SIGTERM, _raise_terminated)
     try:
-        args.run(node, args)
-    except Usage as e:
-        print(f"ros2: {e}", file=sys.stderr)
+        if hasattr(args, "offline"):
+            args.offline(args)
+            return 0
+        return _on_ros(args)
+    except (Usage, ros2_graph.NotFound, ros2_interfaces.UnknownInterface) as e:
+        print(f"ros2: {e}" if isinstance(e, Usage) else e, file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        pass
+        return signal.SIGINT
+    except Terminated:
+        return signal.SIGTERM
+    except BrokenPipeError:         # `ros2 interface list | head`
+        sys.stderr.close()
+        return 0
+
+
+def _on_ros(args: argparse.Namespace) -> int:
+    """The command over DDS, from a hidden node as the real CLI's (`_ros2cli_<pid>`)."""
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    node = rclpy.create_node(f"_ros2cli_{os.getpid()}")
+    try:
+        return args.run(node, args) or 0
     finally:
         sys.stdout.flush()
-        # Fast DDS can spin without end tearing a participant down (eprosima/Fast-DDS#6513;
-        # a `service call` burned a core for 5 min and ignored SIGTERM): the command is done,
-        # so the kernel ends the process if the teardown takes longer than TEARDOWN_S.
+        # No signal ends the teardown half-way; Fast DDS can spin without end tearing a
+        # participant down (eprosima/Fast-DDS#6513; a `service call` burned a core for 5 min
+        # and ignored SIGTERM): the command is done, so the kernel ends the process if the
+        # teardown takes longer than TEARDOWN_S.
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
         signal.signal(signal.SIGALRM, signal.SIG_DFL)
         signal.alarm(TEARDOWN_S)
         node.destroy_node()
         rclpy.try_shutdown()
-    return 0
 
 
 if __name__ == "__main__":
