@@ -8,6 +8,7 @@ state; buttons from `controls.CONTROLS`.
 """
 from __future__ import annotations
 
+import logging
 import socket
 import threading
 import time
@@ -16,10 +17,12 @@ from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
+import rich
 import viser
 from viser.extras import ViserUrdf
 
 from acti_view.controls import CONTROLS, Control, press
+from acti_view.follow import EYE, LOOK_AT, RobotFollow
 from acti_view.sample import ArmPanel, BasePanel, Reader, ViewSample, state_words
 
 TRAIL_STEP_M = 0.002          # a trail gets a point when the robot moved this far
@@ -59,9 +62,14 @@ class LiveView:
         self.period = 1.0 / rate_hz
         self.log = log
         check_host(host)
+        rich.reconfigure(quiet=True)     # viser's own box and lines: the URL goes to `log`
+        logging.getLogger("websockets").setLevel(logging.WARNING)   # "server listening" …
         self.server = viser.ViserServer(host=host, port=port, label="acti_ros2", verbose=False)
-        self.server.initial_camera.position = (1.7, -1.8, 1.3)
-        self.server.initial_camera.look_at = (0.2, 0.0, 0.5)
+        self.server.initial_camera.position = tuple(EYE)
+        self.server.initial_camera.look_at = tuple(LOOK_AT)
+        # the panel beside the scene, not over it (and collapsible): it hid the robot
+        self.server.gui.main_panel.dock_right()
+        self.follow = RobotFollow(self.server)
         scene = self.server.scene
         scene.add_grid("/floor", width=10.0, height=10.0, cell_size=0.25, section_size=1.0)
         self.robot = scene.add_frame("/robot", show_axes=False)
@@ -183,6 +191,7 @@ class LiveView:
                 _points(scene, "/targets/arm", s.arm_targets, GREEN, 0.03)
                 _points(scene, "/targets/base", [(x_, y_, 0.01) for x_, y_ in s.base_targets],
                         RED, 0.06)
+        self.follow.moved(s.world.base_position)
         if self.frames % PANEL_EVERY == 1:
             text = panel_text(s.arm, s.base)
             if text != self._panel_text:

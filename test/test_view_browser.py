@@ -104,3 +104,36 @@ def test_stop_in_the_page_stops_the_arm(ros, page, arm_state, joint_states):
     j1 = call(ros, "get_feedback_pos_joint", srv.GetFeedbackPosJoint).pos[0]
     assert j1 > -85.0, f"J1 {j1}°: the arm was not stopped on its way to -90°"
     assert wait_until(lambda: "arm stop: OK" in page_text(page), 30.0, period=0.5), page_text(page)
+
+
+def canvas_box(driver) -> tuple[int, int, int, int]:
+    """(left, top, width, height) of the 3D view in the page: the panel is docked beside it."""
+    box = driver.execute_script(
+        "const r = document.querySelector('canvas').getBoundingClientRect();"
+        "return [r.left, r.top, r.width, r.height];")
+    return tuple(round(v) for v in box)
+
+
+def test_the_view_follows_the_base_3_m_away_and_the_panel_leaves_it_in_sight(ros, page, tmp_path):
+    """The camera stayed at the world's origin and the panel covered the right quarter: the
+    base was out of sight 2.2 m away. Driven 3 m away, it is in the middle of the view."""
+    base = "/vehicle_node/"
+    for name, srv_type in (("set_power", srv.VehicleSetPower), ("set_servo", srv.VehicleSetServo)):
+        assert ros.call(srv_type, base + name, on_off=True).success
+    target = srv.VehicleMoveLinearAbs.Request().pos
+    target.x = 3000.0
+    assert ros.call(srv.VehicleMoveLinearAbs, base + "move_linear_abs", pos=target).success
+    assert ros.spin_until(lambda: ros.call(srv.VehicleGetPosition, base + "get_position")
+                          .pos.x > 2990.0, 120.0)
+    left, top, width, height = canvas_box(page)
+    page_width = page.execute_script("return window.innerWidth")
+    assert 0.4 * page_width < width < page_width - 200, (width, page_width)   # the panel beside
+
+    def in_the_middle() -> bool:
+        image = saved(tmp_path / "far.png", screenshot(page))
+        view = robot_pixels(image[top:top + height, left:left + width], panel_width=0, top=0)
+        if view.sum() < 300:
+            return False
+        ys, xs = np.nonzero(view)
+        return abs(xs.mean() / width - 0.5) < 0.25 and abs(ys.mean() / height - 0.5) < 0.25
+    assert wait_until(in_the_middle, 60.0, period=0.5), f"the robot is not in view: see {tmp_path}"

@@ -59,7 +59,7 @@ def screenshot(driver, attempts: int = 6) -> np.ndarray:
 def robot_pixels(image: np.ndarray, panel_width: int = 360, top: int = 160) -> np.ndarray:
     """Mask of the robot's orange links in a screenshot of the view (the GUI panel on the right
     and the notices at the top cut off)."""
-    view = image[top:, :-panel_width].astype(int)
+    view = image[top:, :image.shape[1] - panel_width].astype(int)
     r, g, b = view[..., 0], view[..., 1], view[..., 2]
     return (r > 140) & (g > 0.3 * r) & (g < 0.75 * r) & (b < 0.45 * r)
 
