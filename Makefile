@@ -6,6 +6,7 @@ PY := $(VENV)/bin/python
 ENV := source tools/env.sh
 BUILD_DEPS_STAMP := $(VENV)/.build-deps-stamp
 DEPS_STAMP := $(VENV)/.deps-stamp
+ACTIVATE_HOOK := $(VENV)/.activate-hook
 BUILD_STAMP = install/.build-stamp-cpp-$(ACTI_MSGS_CPP)
 COLCON_PATHS := --base-paths . msg_defs
 INTERFACES := $(shell find msg_defs -type f -not -name '*~')
@@ -23,17 +24,33 @@ CMAKE_ARGS := -DBUILD_TESTING=OFF -DPython3_EXECUTABLE=$(abspath $(PY)) \
   -DCMAKE_CXX_COMPILER_LAUNCHER=ccache
 
 BROWSER := /usr/lib/chromium/chromium-headless-shell /usr/bin/chromedriver
-VIEW_URL := http://127.0.0.1:8080/
 
-.PHONY: build setup run test bench clean browser
+.PHONY: build setup stage-interfaces stage-wheels run test bench clean browser
 
 build: $(BUILD_STAMP)
 
-# Everything run and test need. The interface packages need only requirements-build.txt, so the
-# rest of the venv (PyBullet, Pinocchio, viser: most of the download) is installed while they
-# build: two jobs, whatever -j make was given.
+# Everything run and test need, in stages: the terminal shows a line a stage with its time
+# (tools/stage.sh), what they print goes to log/setup/<stage>.log. The interface packages need
+# only requirements-build.txt, so the rest of the venv (PyBullet, Pinocchio, viser: most of the
+# download) is installed while they build: two jobs, whatever -j make was given.
+SETUP_LOG := log/setup
+STAGE := tools/stage.sh
+SUBMAKE := $(MAKE) --no-print-directory
 setup:
-	@$(MAKE) --no-print-directory -j2 $(BUILD_STAMP) $(DEPS_STAMP)
+	@echo "setup: each stage's output goes to $(SETUP_LOG)/"
+	@start=$$SECONDS && \
+	$(STAGE) "venv, the build's wheels (ROS 2 Python, colcon, ccache)" $(SETUP_LOG)/venv.log \
+	  $(SUBMAKE) $(BUILD_DEPS_STAMP) $(ACTIVATE_HOOK) && \
+	$(SUBMAKE) -j2 stage-interfaces stage-wheels && \
+	took=$$((SECONDS - start)) && printf 'setup done in %d:%02d\n' $$((took / 60)) $$((took % 60))
+
+stage-interfaces:
+	@$(STAGE) "interfaces: acti_msgs and the standard ones PyPI lacks" $(SETUP_LOG)/interfaces.log \
+	  $(SUBMAKE) $(BUILD_STAMP)
+
+stage-wheels:
+	@$(STAGE) "the rest of the venv (PyBullet, Pinocchio, TOPP-RA, viser)" $(SETUP_LOG)/wheels.log \
+	  $(SUBMAKE) $(DEPS_STAMP)
 
 # pip's HTTP cache keeps nothing from this registry, so the wheels are kept in a wheelhouse: a new
 # venv (another clone, `rm -r .venv`) installs from it without the network; the lock pins every
@@ -54,6 +71,13 @@ $(BUILD_DEPS_STAMP): requirements-build.txt requirements.lock tools/fix_cmake_pa
 	$(PY) tools/fix_cmake_paths.py $(VENV)
 	touch $@
 
+# `source .venv/bin/activate` alone says to source tools/env.sh instead (tools/venv_hint.sh).
+$(ACTIVATE_HOOK): $(BUILD_DEPS_STAMP)
+	grep -q venv_hint.sh $(VENV)/bin/activate || \
+	  echo '[ ! -f "$$VIRTUAL_ENV/../tools/venv_hint.sh" ] || . "$$VIRTUAL_ENV/../tools/venv_hint.sh"' \
+	  >> $(VENV)/bin/activate
+	touch $@
+
 $(DEPS_STAMP): $(BUILD_DEPS_STAMP) requirements.txt
 	$(call install_from_wheelhouse,requirements.txt)
 	touch $@
@@ -72,9 +96,10 @@ browser:
 	  DEBIAN_FRONTEND=noninteractive apt-get install -y chromium-headless-shell chromium-driver; \
 	  break; }; done
 
+# The job says READY, with the live view's URL (the port it took), once it serves.
 run: setup
-	@echo "live view: $(VIEW_URL) (the log says so if that port was taken; view_enabled:=false turns it off)"
-	$(ENV) && exec python -m acti_bringup --ros-args --params-file config/acti_ros2.yaml
+	@echo "starting the nodes and the live view (python -m acti_bringup):"
+	@$(ENV) && exec python -m acti_bringup --ros-args --params-file config/acti_ros2.yaml
 
 test: setup browser
 	$(ENV) && colcon --log-base log test $(COLCON_PATHS) --packages-select acti_ros2 \

@@ -30,12 +30,12 @@ class NodeProcess:
     fleet, a parameter file); stopped by PID (SIGINT, then SIGKILL)."""
 
     def __init__(self, module: str, log_path: str, *params: str, args: tuple[str, ...] = (),
-                 namespace: str = "", params_file: str = "") -> None:
+                 namespace: str = "", params_file: str | tuple[str, ...] = "") -> None:
         command = [sys.executable, "-m", module, *args, "--ros-args"]
         if namespace:
             command += ["-r", f"__ns:={namespace}"]
-        if params_file:
-            command += ["--params-file", params_file]
+        for path in [params_file] if isinstance(params_file, str) else params_file:
+            command += ["--params-file", path] if path else []
         for p in params:
             command += ["-p", p]
         self.log_path = log_path

@@ -133,6 +133,7 @@ class Simulation:
         self.executor.start(prepare=self._schedule_control_loop)
         planes.outbox.put(self._schedule_control_loop)       # it carries the loop's messages
         planes.start()
+        nodes[0].get_logger().info(ready_banner(nodes))
         try:
             wait_for_signal(lambda: planes.serving() and not self.executor.failed)
         finally:
@@ -147,6 +148,15 @@ class Simulation:
             raise error
         if self.executor.failed:
             raise self.executor.error
+
+
+def ready_banner(nodes: tuple[Node, ...]) -> str:
+    """The line that says the job serves: its nodes, the live view's URL (the port it took),
+    how to stop it."""
+    names = ", ".join(n.get_fully_qualified_name() for n in nodes)
+    urls = [n.view.url for n in nodes if getattr(n, "view", None) is not None]
+    view = f" | live view: {urls[0]}" if urls else ""
+    return f"READY: {names} serving{view} | Ctrl-C to stop"
 
 
 def run_alone(node_class: type, args: list[str] | None = None) -> None:

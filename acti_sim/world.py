@@ -11,7 +11,11 @@ import os
 from dataclasses import dataclass
 
 import numpy as np
-import pybullet
+
+from acti_sim.quiet import output_silenced
+
+with output_silenced():         # its build time, printed on import
+    import pybullet
 import pybullet_data
 
 URDF_PATH = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),

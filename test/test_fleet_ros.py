@@ -105,10 +105,25 @@ def test_the_shared_diagnostics_name_each_robot(ros, robot1, robot2):
         ros.node.destroy_subscription(sub)
 
 
-def test_a_second_job_in_a_robots_namespace_is_reported(ros, robot1, robot2, tmp_path):
-    """It starts (the graph can list a job that has just ended), and both say what is wrong."""
+def test_a_second_job_in_a_robots_namespace_refuses_to_start(robot1, robot2, tmp_path):
+    """Exit status 2 and one line: which names, and how to start it all the same."""
     twin = NodeProcess("acti_bringup", str(tmp_path / "twin.log"), TEST_RATE,
                        "view_enabled:=false", namespace="/robot2")
+    try:
+        assert twin.proc.wait(timeout=120) == 2, twin.log()
+    finally:
+        twin.stop()
+    fatal = [line for line in twin.log().splitlines() if line.startswith("[FATAL]")]
+    assert len(fatal) == 1 and "Traceback" not in twin.log(), twin.log()
+    assert "/robot2/acti_middle_node, /robot2/vehicle_node, /robot2/acti_view already served" \
+        in fatal[0] and "-r __ns:=" in fatal[0] and "allow_namesakes:=true" in fatal[0], fatal[0]
+
+
+def test_a_second_job_allowed_in_a_robots_namespace_is_reported(ros, robot1, robot2, tmp_path):
+    """It starts with allow_namesakes (the graph can list a job that has just ended), and both
+    say what is wrong."""
+    twin = NodeProcess("acti_bringup", str(tmp_path / "twin.log"), TEST_RATE,
+                       "view_enabled:=false", "allow_namesakes:=true", namespace="/robot2")
     try:
         said = "another job runs as /robot2/vehicle_node"
         assert wait_until(lambda: said in twin.log() and said in robot2.log(), 30.0), twin.log()

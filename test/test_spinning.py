@@ -6,6 +6,8 @@ refuse ends them with one line and exit status 2."""
 from __future__ import annotations
 
 import signal
+import subprocess
+import sys
 import time
 
 import pytest
@@ -14,6 +16,7 @@ from acti_msgs.srv import GetState, VehicleGetState
 from rclpy.action import ActionServer
 from std_srvs.srv import Trigger
 
+from acti_bringup.harness import ROOT
 from acti_bringup.serving.outbox import UnlockedActionHandle
 from acti_bringup.serving.spinning import SPIN_TIMEOUT_S, Planes
 from ros_harness import NodeProcess, wait_until
@@ -154,6 +157,21 @@ def test_help_prints_the_usage_and_starts_nothing(tmp_path, module):
         node.stop()
     assert f"python -m {module}" in node.log() and "--ros-args" in node.log()
     assert "services under" not in node.log(), node.log()
+    assert "    queue_size: 32 [1 … 100000]  motion queue capacity" in node.log(), node.log()
+    assert "    rate_hz: 250.0 [10 … 2000]  physics and control rate [Hz]" in node.log()
+    assert "    allow_namesakes: False  start even where a node" in node.log()
+
+
+def test_help_again_imports_no_simulation(tmp_path):
+    """The list of parameters is made once (it builds the nodes out of sight) and kept: a
+    second `--help` imports neither the simulation nor the motion core (it took 3-6 s)."""
+    help_ = [sys.executable, "-X", "importtime", "-m", "vehicle_node", "--help"]
+    subprocess.run(help_, capture_output=True, cwd=ROOT, check=True, timeout=120)
+    again = subprocess.run(help_, capture_output=True, text=True, cwd=ROOT, check=True,
+                           timeout=120)
+    imported = {line.split("|")[-1].strip() for line in again.stderr.splitlines()}
+    assert {"acti_sim", "acti_motion", "pybullet", "rclpy"}.isdisjoint(imported), imported
+    assert "  /vehicle_node:\n" in again.stdout
 
 
 def test_nodes_of_one_name_are_one_line_and_exit_status_2(tmp_path):

@@ -38,7 +38,11 @@ from rclpy.node import Node
 from rclpy.publisher import Publisher
 from rclpy.timer import Timer
 
+from acti_bringup.serving.logs import route_python_logging
+from acti_bringup.serving.namesakes import JobConfig, namesakes, refusal
 from acti_bringup.serving.outbox import Outbox, unlock_action, unlocked_publish
+from acti_bringup.serving.parameters import declare_config
+from acti_bringup.serving.params_files import warn_of_unmatched_files
 from acti_bringup.serving.responses import LateResponses
 
 RCLError = rclpy_implementation.RCLError
@@ -60,22 +64,16 @@ def stop_requested() -> bool:
     return _stop_requested.is_set()
 
 
-USAGE_TAIL = ("ROS arguments: --ros-args -r __ns:=/robot1 -p name:=value "
-              "--params-file config/acti_ros2.yaml (docs/interfaces.md: Parameters)")
-
-
+_given_args: list[str] = []        # the process's arguments, as `init` got them
 MAX_DOMAIN_ID = 232     # Fast DDS: 7400 + 250 × domain + offsets must stay a UDP port
 
 
 def init(args: list[str]) -> None:
     """rclpy.init with this module's signal handling instead of rclpy's. ROS arguments rcl
     refuses (a remap it cannot parse, a parameters file it cannot read) and a ROS_DOMAIN_ID
-    DDS cannot use end the process as a refused setting does (`build_or_exit`). `-h`/`--help` prints the usage and exits: it
-    started a robot, in whatever domain the shell had."""
-    own = args[1:args.index("--ros-args")] if "--ros-args" in args else args[1:]
-    if {"-h", "--help"} & set(own):
-        print(f"{(sys.modules['__main__'].__doc__ or '').strip()}\n\n{USAGE_TAIL}")
-        raise SystemExit(0)
+    DDS cannot use end the process as a refused setting does (`build_or_exit`). (`--help` is
+    answered before: `acti_bringup.serving.usage`.)"""
+    _given_args[:] = args
     catch_signals()
     domain = os.environ.get("ROS_DOMAIN_ID", "").strip()
     if domain and not (domain.isdigit() and int(domain) <= MAX_DOMAIN_ID):
@@ -106,16 +104,30 @@ def _cannot_start(name: str, why: BaseException) -> NoReturn:
 def build_or_exit(build: Callable[[], T], name: str) -> T:
     """build() the process's nodes. A start-up setting they refuse (a parameter out of its range
     or of the wrong type, settings that contradict each other) ends the process with one line that
-    says what, and exit status 2: a configuration error, not a traceback."""
+    says what, and exit status 2: a configuration error, not a traceback. What the cores log
+    (Python's `logging`) goes through the first node's logger (`acti_bringup.serving.logs`)."""
+    route_python_logging(get_logger(name))
     try:
         built = build()
-        warn_of_unknown_parameters(built if isinstance(built, tuple) else (built,))
+        nodes = built if isinstance(built, tuple) else (built,)
+        route_python_logging(nodes[0].get_logger())
+        allowed = declare_job_parameters(nodes).allow_namesakes
+        warn_of_unknown_parameters(nodes)
+        warn_of_unmatched_files(nodes, _given_args, nodes[0].get_logger().warning)
+        taken = [] if allowed else namesakes(nodes)
+        if taken:
+            _cannot_start(name, refusal(taken))
         return built
     except (ValueError, InvalidParameterTypeException, InvalidParameterValueException) as e:
         _cannot_start(name, e)
     except RCLError as e:       # a name clash: `-r __node:=x` renames every node of the process
         _cannot_start(name, f"{e} (do two nodes of the process have one name? `-r __node:=…` "
                             "renames every one of them; `-r vehicle_node:__node:=…` one)")
+
+
+def declare_job_parameters(nodes: tuple[Node, ...]) -> JobConfig:
+    """The parameters of the job as a whole, on its first node."""
+    return declare_config(nodes[0], JobConfig)
 
 
 def warn_of_unknown_parameters(nodes: tuple[Node, ...]) -> None:
