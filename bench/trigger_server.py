@@ -4,6 +4,10 @@ Served the way the nodes serve their control plane (`acti_bringup.serving.spinni
 driven by a spin_once loop), so the ratio measures the nodes' own cost, not an executor choice:
 
     python -m bench.trigger_server [events|single|multi]   a std_srvs/Trigger, /bare_trigger/trigger
+    python -m bench.trigger_server follow                  a control_msgs FollowJointTrajectory,
+                                                           /bare_follow/follow_joint_trajectory, on the
+                                                           goal plane's executor (single): it accepts
+                                                           every goal and succeeds at once
     python -m bench.trigger_server replay [SERVICE ...]    the services named (default: every getter
                                                            of both nodes) as /bare_replay/<node>/<op>:
                                                            a getter answers the reply the running main
@@ -45,6 +49,21 @@ def trigger_node() -> rclpy.node.Node:
     return node
 
 
+def follow_node() -> rclpy.node.Node:
+    """A FollowJointTrajectory server that accepts every goal and succeeds at once."""
+    from control_msgs.action import FollowJointTrajectory
+
+    from acti_bringup.serving.adapter import action_server
+    node = rclpy.create_node("bare_follow")
+
+    def execute(goal_handle):
+        goal_handle.succeed()
+        return FollowJointTrajectory.Result()
+    node.bare_server = action_server(node, FollowJointTrajectory, "~/follow_joint_trajectory",
+                                     execute)
+    return node
+
+
 def replay_node(names: list[str]) -> rclpy.node.Node:
     """The services `names`, each answering one reply: a getter's fetched once from the running
     job, another operation's an OK reply that accepted nothing."""
@@ -71,9 +90,11 @@ def main() -> None:
     init(sys.argv)
     if kind == "replay":
         node = replay_node(args[2:] or [name for name, _ in GETTERS])
+    elif kind == "follow":
+        node = follow_node()
     else:
         node = trigger_node()
-    executor = EXECUTORS[KIND if kind == "replay" else kind]()
+    executor = EXECUTORS[{"replay": KIND, "follow": "single"}.get(kind, kind)]()
     executor.add_node(node)
     loop = SpinLoop(executor, "bare").start()
     try:
