@@ -14,7 +14,7 @@ from acti_msgs.msg import LimitValue
 from action_msgs.msg import GoalStatus
 from builtin_interfaces.msg import Duration
 from control_msgs.action import FollowJointTrajectory, GripperCommand, ParallelGripperCommand
-from control_msgs.msg import GripperCommand as GripperCommandMsg, JointJog
+from control_msgs.msg import GripperCommand as GripperCommandMsg, JointJog, JointTolerance
 from rcl_interfaces.msg import Log
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
@@ -279,6 +279,27 @@ def test_a_goal_is_rejected_while_act_moves_are_queued(robot):
     assert not robot.follow.offer(**moveit_goal(smooth(q, offset(q, 0.1), 1.0))).accepted
     assert robot.logged("ACT motions are running or queued")
     robot.call("stop", srv.Stop)
+
+
+def test_tolerances_abort_with_their_codes(robot):
+    """A path tolerance the tracking cannot keep stops the arm; a goal tolerance it cannot reach
+    aborts goal_time_tolerance after the end."""
+    robot.ready()
+    q0 = robot.joints()
+    tight = [JointTolerance(name="joint1", position=1e-7)]
+    handle = robot.follow.send(trajectory=smooth(q0, offset(q0, 0.3), 2.0), path_tolerance=tight)
+    status, result = robot.follow.result(handle)
+    assert status == GoalStatus.STATUS_ABORTED
+    assert result.error_code == Result.PATH_TOLERANCE_VIOLATED and "joint1 position" in \
+        result.error_string
+    assert robot.until(lambda: not robot.state() & 0x02)
+    q = robot.joints()
+    handle = robot.follow.send(trajectory=smooth(q, offset(q, 0.1), 1.0), goal_tolerance=[
+        JointTolerance(name="joint2", position=1e-12)], goal_time_tolerance=Duration(
+        nanosec=200_000_000))
+    status, result = robot.follow.result(handle)
+    assert status == GoalStatus.STATUS_ABORTED
+    assert result.error_code == Result.GOAL_TOLERANCE_VIOLATED and "joint2" in result.error_string
 
 
 # --- the gripper -------------------------------------------------------------------------------------

@@ -169,3 +169,36 @@ def test_servo_off_refuses_a_trajectory(executor, arm):  # noqa: F811
     arm.servo_off()
     with pytest.raises(Refused, match="servo is off"):
         follower.follow(validate(four_points(), ARM_JOINTS, follower.now()), "t")
+
+
+# --- stamps and jogs -------------------------------------------------------------------------------
+def test_a_stamp_in_the_future_holds_and_one_in_the_past_joins_the_rest():
+    from acti_motion.trajectory.interpolation import State
+    from acti_motion.trajectory.limits import follow_plan
+    start = State(Q0, np.zeros(7), np.zeros(7))
+    req = request((0.0, 0.0), (0.1, 1.0), (0.2, 2.0), velocities=True, start=10.0)
+    valid = validate(req, ARM_JOINTS, now=9.0)
+    ahead = follow_plan(valid, start, 9.5, ARM_JOINTS)        # starts in 0.5 s: hold till then
+    assert [k.time for k in ahead.knots] == [0.0, 0.5, 1.5, 2.5] and ahead.points == [-1, -1, 1, 2]
+    assert np.allclose(ahead.knots[1].positions, Q0)
+    late = follow_plan(valid, start, 11.5, ARM_JOINTS)        # 1.5 s in: point 2 is left
+    assert [k.time for k in late.knots] == [0.0, 0.5] and late.points == [-1, 2]
+
+
+def test_a_jog_ramps_holds_and_stops_inside_the_soft_limit(executor, arm):  # noqa: F811
+    from acti_motion.trajectory.interpolation import State
+    from acti_motion.trajectory.jog import SOFT_LIMIT_MARGIN_RAD, jog_plan
+    from acti_motion.trajectory.limits import check_limits
+    limits = ArmTrajectories(arm).limits()
+    start = State(Q0, np.zeros(7), np.zeros(7))
+    v = np.zeros(7)
+    v[0] = 0.5
+    plan = jog_plan(v, 1.0, 0.3, limits)(start, 0.0)
+    poly = check_limits(plan, limits)
+    assert poly.duration == pytest.approx(1.6) and poly.state(0.8).velocities[0] == pytest.approx(0.5)
+    assert poly.state(poly.duration).positions[0] == pytest.approx(Q0[0] + 0.5 * 1.3)
+    v[0] = 100.0                                               # far too fast, toward the limit
+    near = State(np.r_[limits.upper[0] - 0.05, Q0[1:]], np.zeros(7), np.zeros(7))
+    poly = check_limits(jog_plan(v, 5.0, 0.3, limits)(near, 0.0), limits)
+    end = poly.state(poly.duration).positions[0]
+    assert limits.upper[0] - 0.01 < end <= limits.upper[0] - SOFT_LIMIT_MARGIN_RAD + 1e-9
