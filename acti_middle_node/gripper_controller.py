@@ -5,8 +5,8 @@ gripper moves, through the same queue as open_gripper and move_gripper):
   <parallel_gripper_controller>/gripper_cmd  control_msgs/action/ParallelGripperCommand
 
 Positions are the finger joint's (gripper_finger_left_joint, m from the centre; the right finger
-mimics it), as MoveIt sends them. reached_goal: the finger came to rest within
-REACHED_TOLERANCE_M of the target; stalled: it came to rest short of it (it holds an object).
+mimics it), as MoveIt sends them. reached_goal and stalled: `acti_motion.arm.gripper.grip_outcome`
+of the finger once at rest (a goal that ends otherwise has neither).
 The simulation does not measure the fingers' effort (reported 0) and applies no effort cap
 (max_effort): the fingers push with the URDF's effort limit. The goal callbacks await their
 plan, so the servers are in a reentrant callback group (as the trajectory controller's).
@@ -25,11 +25,11 @@ from sensor_msgs.msg import JointState
 from acti_bringup.serving.adapter import Plane, action_server
 from acti_bringup.serving.waiting import accept_cancel, device_watch
 from acti_motion.arm.core import ArmCore
+from acti_motion.arm.gripper import grip_outcome
 from acti_motion.config_fields import RATE_RANGE_HZ, ranged
 from acti_motion.replies import Refused
 from acti_sim.world import GRIPPER_JOINTS
 
-REACHED_TOLERANCE_M = 0.0005
 AT_REST_M = 1e-5          # finger travel within AT_REST_WINDOW_S that counts as at rest
 AT_REST_WINDOW_S = 0.02
 
@@ -136,9 +136,10 @@ class GripperController:
                                                          False)),
             closed=lambda why: "abort")
         position = self.finger()
-        reached = abs(position - grip.target) <= REACHED_TOLERANCE_M
+        reached, stalled = grip_outcome(grip.target, position) if end == "succeed" \
+            else (False, False)
         getattr(goal_handle, end)()
-        return message(action.Result, position, end == "succeed" and not reached, reached)
+        return message(action.Result, position, stalled, reached)
 
     def _outcome(self, goal_handle: Any, grip: _Grip) -> str | None:
         """How the goal ends once the finger rests: succeed (reached, or stalled on an object),
