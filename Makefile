@@ -38,18 +38,18 @@ STAGE := tools/stage.sh
 SUBMAKE := $(MAKE) --no-print-directory
 setup:
 	@echo "setup: each stage's output goes to $(SETUP_LOG)/"
-	@start=$$SECONDS && \
+	+@start=$$SECONDS && \
 	$(STAGE) "venv, the build's wheels (ROS 2 Python, colcon, ccache)" $(SETUP_LOG)/venv.log \
 	  $(SUBMAKE) $(BUILD_DEPS_STAMP) $(ACTIVATE_HOOK) && \
 	$(SUBMAKE) -j2 stage-interfaces stage-wheels && \
 	took=$$((SECONDS - start)) && printf 'setup done in %d:%02d\n' $$((took / 60)) $$((took % 60))
 
 stage-interfaces:
-	@$(STAGE) "interfaces: acti_msgs and the standard ones PyPI lacks" $(SETUP_LOG)/interfaces.log \
+	@+$(STAGE) "interfaces: acti_msgs and the standard ones PyPI lacks" $(SETUP_LOG)/interfaces.log \
 	  $(SUBMAKE) $(BUILD_STAMP)
 
 stage-wheels:
-	@$(STAGE) "the rest of the venv (PyBullet, Pinocchio, TOPP-RA, viser)" $(SETUP_LOG)/wheels.log \
+	@+$(STAGE) "the rest of the venv (PyBullet, Pinocchio, TOPP-RA, viser)" $(SETUP_LOG)/wheels.log \
 	  $(SUBMAKE) $(DEPS_STAMP)
 
 # pip's HTTP cache keeps nothing from this registry, so the wheels are kept in a wheelhouse: a new
