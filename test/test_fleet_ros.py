@@ -129,3 +129,16 @@ def test_a_second_job_allowed_in_a_robots_namespace_is_reported(ros, robot1, rob
         assert wait_until(lambda: said in twin.log() and said in robot2.log(), 30.0), twin.log()
     finally:
         twin.stop()
+
+
+def test_each_robots_controllers_are_in_its_namespace(ros, robot1, robot2):
+    """MoveIt's controllers of a robot of the fleet: relative names, prefixed by its namespace."""
+    from rclpy.action import get_action_names_and_types
+    want = {f"/robot{n}/{name}" for n in (1, 2) for name in (
+        "arm_controller/follow_joint_trajectory", "gripper_controller/gripper_cmd",
+        "parallel_gripper_controller/gripper_cmd")}
+    topics = {"/robot1/arm_controller/joint_jog": ["control_msgs/msg/JointJog"],
+              "/robot2/arm_controller/joint_trajectory": ["trajectory_msgs/msg/JointTrajectory"]}
+    assert wait_until(lambda: want <= dict(get_action_names_and_types(ros.node)).keys(), 30.0)
+    assert wait_until(lambda: topics.items() <= dict(ros.node.get_topic_names_and_types()).items(),
+                      30.0)
