@@ -9,13 +9,15 @@ import sys
 
 from acti_bringup.serving.usage import exit_if_help
 
+BUILDER = "acti_bringup.__main__:nodes"      # what builds the job's nodes (--help lists theirs)
+
 
 def main(args: list[str] | None = None) -> None:
     args = sys.argv if args is None else args
-    exit_if_help(args, __doc__, "acti_bringup.__main__:nodes")
+    exit_if_help(args, __doc__, BUILDER)
     from acti_bringup.serving.spinning import build_or_exit, init   # after --help: seconds
     init(args)
-    arm, vehicle, view = build_or_exit(nodes, "acti_bringup")
+    arm, vehicle, view = build_or_exit(nodes, "acti_bringup", BUILDER)
     arm.simulation.spin(arm, vehicle, view)
 
 

@@ -162,5 +162,6 @@ def ready_banner(nodes: tuple[Node, ...]) -> str:
 def run_alone(node_class: type, args: list[str] | None = None) -> None:
     """`python -m <node>`: one node with a simulation of its own, until SIGINT/SIGTERM."""
     init(sys.argv if args is None else args)
-    node = build_or_exit(node_class, node_class.__module__.split(".")[0])
+    node = build_or_exit(node_class, node_class.__module__.split(".")[0],
+                         f"{node_class.__module__}:{node_class.__name__}")
     node.simulation.spin(node)

@@ -171,7 +171,7 @@ def test_help_again_imports_no_simulation(tmp_path):
                            timeout=120)
     imported = {line.split("|")[-1].strip() for line in again.stderr.splitlines()}
     assert {"acti_sim", "acti_motion", "pybullet", "rclpy"}.isdisjoint(imported), imported
-    assert "  /vehicle_node:\n" in again.stdout
+    assert "  vehicle_node:\n" in again.stdout
 
 
 def test_nodes_of_one_name_are_one_line_and_exit_status_2(tmp_path):

@@ -144,6 +144,7 @@ def declare_config(node: Node, config_type: type[C],
         descriptor = _descriptor(f, declared, notes.get(f.name, ""), f.name in settings)
         start, own = _start_up_value(node, f.name, declared)
         value = node.declare_parameter(f.name, start, descriptor, ignore_override=own).value
+        _defaults_of(node)[f.name] = declared
         _check_finite(f.name, value)
         values[f.name] = tuple(value) if isinstance(default, tuple) else value
     if settings:
@@ -157,6 +158,13 @@ def sync_parameters(node: Node) -> None:
     registry = getattr(node, "_acti_parameters", None)
     if registry is not None:
         registry.sync()
+
+
+def _defaults_of(node: Node) -> dict[str, Any]:
+    """The declared default of each parameter (what `--help` lists; -p may have set another)."""
+    if not hasattr(node, "_acti_defaults"):
+        setattr(node, "_acti_defaults", {})
+    return getattr(node, "_acti_defaults")
 
 
 def _parameters_of(node: Node) -> _Parameters:

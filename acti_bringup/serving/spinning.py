@@ -44,6 +44,7 @@ from acti_bringup.serving.outbox import Outbox, unlock_action, unlocked_publish
 from acti_bringup.serving.parameters import declare_config
 from acti_bringup.serving.params_files import warn_of_unmatched_files
 from acti_bringup.serving.responses import LateResponses
+from acti_bringup.serving.usage import remember_parameters
 
 RCLError = rclpy_implementation.RCLError
 T = TypeVar("T")
@@ -101,11 +102,13 @@ def _cannot_start(name: str, why: BaseException) -> NoReturn:
     raise SystemExit(2)
 
 
-def build_or_exit(build: Callable[[], T], name: str) -> T:
+def build_or_exit(build: Callable[[], T], name: str, builder: str = "") -> T:
     """build() the process's nodes. A start-up setting they refuse (a parameter out of its range
     or of the wrong type, settings that contradict each other) ends the process with one line that
     says what, and exit status 2: a configuration error, not a traceback. What the cores log
-    (Python's `logging`) goes through the first node's logger (`acti_bringup.serving.logs`)."""
+    (Python's `logging`) goes through the first node's logger (`acti_bringup.serving.logs`).
+    `builder` ("module:function" of `build`) names the list of parameters `--help` prints: kept
+    now if it is not yet (`acti_bringup.serving.usage`)."""
     route_python_logging(get_logger(name))
     try:
         built = build()
@@ -117,6 +120,8 @@ def build_or_exit(build: Callable[[], T], name: str) -> T:
         taken = [] if allowed else namesakes(nodes)
         if taken:
             _cannot_start(name, refusal(taken))
+        if builder:
+            remember_parameters(builder, nodes)
         return built
     except (ValueError, InvalidParameterTypeException, InvalidParameterValueException) as e:
         _cannot_start(name, e)

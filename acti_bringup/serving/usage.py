@@ -47,9 +47,26 @@ def _sources_key(builder: str) -> str:
     return digest.hexdigest()[:16]
 
 
+def _cached(builder: str) -> Path:
+    return CACHE / f"{builder.replace(':', '.')}-{_sources_key(builder)}.txt"
+
+
+def _keep(builder: str, text: str) -> None:
+    CACHE.mkdir(parents=True, exist_ok=True)
+    for old in CACHE.glob(f"{builder.replace(':', '.')}-*.txt"):
+        old.unlink()
+    _cached(builder).write_text(text, encoding="utf-8")
+
+
+def remember_parameters(builder: str, nodes: tuple[Any, ...]) -> None:
+    """Keep the list of a job that has built its nodes (no child needed for `--help` then)."""
+    if not _cached(builder).exists():
+        _keep(builder, describe(nodes))
+
+
 def parameters_text(builder: str) -> str:
     """The parameters section, from the cache or made now (and kept)."""
-    cached = CACHE / f"{builder.replace(':', '.')}-{_sources_key(builder)}.txt"
+    cached = _cached(builder)
     if cached.exists():
         return cached.read_text(encoding="utf-8")
     env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE="OFF")
@@ -57,10 +74,7 @@ def parameters_text(builder: str) -> str:
                           text=True, env=env, cwd=ROOT, timeout=300)
     if done.returncode != 0 or not done.stdout.startswith("Parameters"):
         return f"(the parameters could not be listed: {done.stderr.strip()[-500:]})\n"
-    CACHE.mkdir(parents=True, exist_ok=True)
-    for old in CACHE.glob(f"{builder.replace(':', '.')}-*.txt"):
-        old.unlink()
-    cached.write_text(done.stdout, encoding="utf-8")
+    _keep(builder, done.stdout)
     return done.stdout
 
 
@@ -70,18 +84,19 @@ def _value(value: Any) -> str:
 
 
 def describe(nodes: tuple[Any, ...]) -> str:
-    """Each visible node's parameters: `name: default [lo … hi] (type) description`."""
+    """Each visible node's parameters: `name: default [lo … hi]  description` (the default
+    as declared, whatever -p or a parameters file set)."""
     lines = ["Parameters (-p name:=value reaches every node; a --params-file section one; "
              "`ros2 param describe` says the same at run time):"]
     for node in nodes:
         if node.get_name().startswith("_"):
             continue
-        lines.append(f"  {node.get_fully_qualified_name()}:")
+        lines.append(f"  {node.get_name()}:")
         for name in sorted(node._parameters):
             d = node.describe_parameter(name)
             bounds = "".join(f" [{r.from_value:g} … {r.to_value:g}]" for r in d.floating_point_range)
             bounds += "".join(f" [{r.from_value} … {r.to_value}]" for r in d.integer_range)
-            value = node.get_parameter(name).value
+            value = getattr(node, "_acti_defaults", {}).get(name, node.get_parameter(name).value)
             lines.append(f"    {name}: {_value(value)}{bounds}  {d.description}".rstrip())
     return "\n".join(lines) + "\n"
 
