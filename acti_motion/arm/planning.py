@@ -22,7 +22,7 @@ from acti_motion.arm.kinematics import Unreachable, rotate_about
 from acti_motion.arm.poses import Frames, inverse
 from acti_motion.arm.trajectories import (ArmMotion, ArmSetpoint, CartesianLimits,
                                           CartesianPath, CartesianPlanner, LinearJointPath,
-                                          positions_along)
+                                          LinePath, convex_checkpoints, positions_along)
 from acti_motion.profiles import Trapezoid
 from acti_motion.replies import Refused, Reply, ReturnCode, value_error
 
@@ -249,12 +249,13 @@ class MovePlanning:
                 self.planner.check_length(path, frames)
             except ValueError as e:
                 raise value_error(f"{label}: {e}") from None
-            coarse = positions_along(path, np.linspace(0.0, 1.0, REACH_SAMPLES + 1))
+            coarse = convex_checkpoints(path, np.linspace(0.0, 1.0, REACH_SAMPLES + 1))
             self._check_cartesian_positions(coarse * 1000.0, label)
             self._check_reach(coarse, frames, label)
-            ss = np.linspace(0.0, 1.0, min(MAX_CHECK_SAMPLES,
-                                           1 + max(2, math.ceil(path.length / 0.002))))
-            self._check_cartesian_positions(positions_along(path, ss) * 1000.0, label)
+            if not isinstance(path, LinePath):       # a line's ends told it all (convex)
+                ss = np.linspace(0.0, 1.0, min(MAX_CHECK_SAMPLES,
+                                               1 + max(2, math.ceil(path.length / 0.002))))
+                self._check_cartesian_positions(positions_along(path, ss) * 1000.0, label)
             goal_psi, goal_turn = self._elbow_goal(start.joints, frames.flange_of(path.pose(1.0)),
                                                    psi, turn)
             try:

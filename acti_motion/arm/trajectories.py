@@ -35,6 +35,10 @@ from acti_motion.profiles import Trapezoid
 from acti_sim.world import World
 
 logging.getLogger("toppra").setLevel(logging.WARNING)
+# Every TOPPRA(...) asks importlib whether qpoases and cvxpy are installed (~0.25 ms of a plan,
+# more with a long sys.path): the answer cannot change within a process.
+ta.solverwrapper.available_solvers = functools.lru_cache(maxsize=None)(
+    ta.solverwrapper.available_solvers)
 
 PATH_TOLERANCE_MM = 0.02
 PATH_TOLERANCE_DEG = 0.01
@@ -266,6 +270,16 @@ def positions_along(path: CartesianPath, ss: np.ndarray) -> np.ndarray:
     if _own(path):
         return path.positions(ss)
     return np.array([path.position(s) for s in ss])
+
+
+def convex_checkpoints(path: CartesianPath, ss: np.ndarray) -> np.ndarray:
+    """Positions of `path` (N×3) that tell whether it keeps to a convex region (the soft-limit
+    box, the reach's ball) and where it first leaves one: a line's two ends (a line leaves a
+    convex region at most once, so its end is outside if and only if it does), else the
+    positions at ss."""
+    if isinstance(path, LinePath):
+        return positions_along(path, np.array([0.0, 1.0]))
+    return positions_along(path, ss)
 
 
 # --- planning ---------------------------------------------------------------------------------------
