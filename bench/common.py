@@ -135,22 +135,6 @@ def cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
-def thread_cpu_seconds(pid: int, name: str) -> float:
-    """User + system CPU time that the threads called `name` of a process have used so far."""
-    total = 0.0
-    for tid in os.listdir(f"/proc/{pid}/task"):
-        try:
-            with open(f"/proc/{pid}/task/{tid}/comm") as f:
-                if f.read().strip() != name:
-                    continue
-            with open(f"/proc/{pid}/task/{tid}/stat") as f:
-                fields = f.read().rsplit(")", 1)[1].split()
-        except FileNotFoundError:
-            continue
-        total += (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
-    return total
-
-
 def idle_cpu_percent(pid: int, seconds: float = 5.0) -> float:
     """Share of one core a process uses over `seconds` of wall time."""
     c0, t0 = cpu_seconds(pid), time.monotonic()
@@ -198,5 +182,4 @@ def simulated_base(velocity: tuple[float, float] | None = None,
 
 
 __all__ = ["Actions", "RosClient", "running", "bare_call", "interleaved", "latencies", "against",
-           "row", "table", "p", "worst_ratios", "idle_cpu_percent", "thread_cpu_seconds",
-           "simulated_arm", "simulated_base"]
+           "row", "table", "p", "worst_ratios", "idle_cpu_percent", "simulated_arm", "simulated_base"]

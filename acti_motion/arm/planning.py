@@ -196,11 +196,11 @@ class MovePlanning:
         if psi is not None:
             return psi, 0.0
         kin = self.kin
-        u0 = kin.elbow_direction(start_q)[0]
+        u0, n0 = kin.elbow_direction(start_q)
         w = kin.wrist_of(flange) - kin.shoulder
         u1 = w / max(float(np.linalg.norm(w)), 1e-12)
         if min(kin.reference_strength(u0), kin.reference_strength(u1)) > REL_ELBOW_CLEARANCE:
-            return kin.angle_of(*kin.elbow_direction(start_q)) + turn, 0.0
+            return kin.angle_of(u0, n0) + turn, 0.0
         return None, turn
 
     def _queue_ptp_cartesian(self, target_of: Callable[[np.ndarray], np.ndarray], label: str, *,
