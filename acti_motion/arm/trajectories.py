@@ -45,6 +45,7 @@ PATH_TOLERANCE_DEG = 0.01
 MAX_JOINT_STEP = math.radians(2.0)   # between IK samples of a CP path
 MAX_SAMPLES = 4000
 TOPPRA_GRID = 201
+ELBOW_GRID_FLOOR = 4      # least intervals of the grid the elbow is carried on along a CP path
 
 
 @dataclass(frozen=True)
@@ -344,7 +345,7 @@ class CartesianPlanner:
     def _elbow_plan(self, path: CartesianPath, to_flange: Callable[[np.ndarray], np.ndarray],
                     start_q: np.ndarray, psi: float | None, turn: float) -> "_ElbowPlan":
         kin = self.kin
-        grid = np.linspace(0.0, 1.0, 1 + min(128, max(16, math.ceil(path.length / 0.005),
+        grid = np.linspace(0.0, 1.0, 1 + min(128, max(ELBOW_GRID_FLOOR, math.ceil(path.length / 0.005),
                                                       math.ceil(path.angle / 0.02))))
         us = _units(kin.wrist_of(to_flange(poses_along(path, grid))) - kin.shoulder)
         n = kin.elbow_direction(start_q)[1].tolist()
@@ -492,15 +493,18 @@ def _insert(ss: np.ndarray, qs: np.ndarray, where: np.ndarray,
     return np.insert(ss, where + 1, mids), np.insert(qs, where + 1, solve(mids, qs[where]), axis=0)
 
 
+STRAY_M2 = (PATH_TOLERANCE_MM / 1000.0) ** 2
+STRAY_COS = math.cos(math.radians(PATH_TOLERANCE_DEG))
+
+
 def _strays(want: np.ndarray, got: np.ndarray) -> np.ndarray:
-    """Which poses of `got` miss those of `want` (N×4×4 each) by more than the path tolerance."""
-    off_mm = np.linalg.norm(want[:, :3, 3] - got[:, :3, 3], axis=1) * 1000.0
-    rel = got[:, :3, :3] @ want[:, :3, :3].transpose(0, 2, 1)
-    sin2 = np.stack([rel[:, 2, 1] - rel[:, 1, 2], rel[:, 0, 2] - rel[:, 2, 0],
-                     rel[:, 1, 0] - rel[:, 0, 1]], axis=1)
-    cos = (np.trace(rel, axis1=1, axis2=2) - 1.0) / 2
-    angle = np.degrees(np.arctan2(np.linalg.norm(sin2, axis=1) / 2, cos))
-    return (off_mm > PATH_TOLERANCE_MM) | (angle > PATH_TOLERANCE_DEG)
+    """Which poses of `got` miss those of `want` (N×4×4 each) by more than the path tolerance:
+    the rotation between them turns by more than the angle whose cosine is (trace − 1) / 2, and
+    the trace of got·wantᵀ is the sum of their elements' products (a few numpy calls: this runs
+    on every refinement of every CP plan)."""
+    d = want[:, :3, 3] - got[:, :3, 3]
+    cos = (np.einsum("nij,nij->n", got[:, :3, :3], want[:, :3, :3]) - 1.0) / 2
+    return (np.einsum("ni,ni->n", d, d) > STRAY_M2) | (cos < STRAY_COS)
 
 
 def _units(v: np.ndarray) -> np.ndarray:
