@@ -200,7 +200,10 @@ class Device:
                     ids = []
                     for motion, (_, label) in zip(motions, plans):
                         self.last_id += 1
-                        self.queue.append(QueuedMotion(self.last_id, motion, label))
+                        if motion.duration <= 0.0 and self.idle and not self.paused:
+                            self._complete_at_once(motion)
+                        else:
+                            self.queue.append(QueuedMotion(self.last_id, motion, label))
                         ids.append(self.last_id)
                     self.revision += 1
                     if self._stop_at is None:
@@ -523,6 +526,16 @@ class Device:
         if last is self.current and self._stop_at is not None:
             return last.motion.at(self._stop_at)
         return last.motion.at(last.motion.duration)
+
+    def _complete_at_once(self, motion: Motion) -> None:
+        """The motion just given an id takes no time on an idle device: it is over now, and the
+        device rests at its end, as if a step had run it (queued, it held the device busy until
+        a step picked it up)."""
+        self.hold = self.queued_end = motion.at(motion.duration)
+        self.completed += 1
+        self.retired_id = max(self.retired_id, self.last_id)
+        self.changed.notify_all()
+        self._announce_retired()
 
     def _accept_discarded(self) -> int:
         """A new id, retired at once as discarded (a stop overtook it)."""

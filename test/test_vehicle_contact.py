@@ -1,9 +1,12 @@
 """Contact sensor and blockage without ROS: a bumper contact locks the base until unlock; a
 blocked base stops as Stuck."""
+from dataclasses import replace
+
 import pytest
 
 from acti_motion.vehicle.core import VehicleState
 from acti_motion.vehicle.alarms import AlarmCode
+from acti_sim.world import WHEEL_JOINTS
 from sim_fixtures import executor, run_until  # noqa: F401
 from vehicle_fixtures import base, position, ready, settle, state, state_msg, steps  # noqa: F401
 
@@ -37,9 +40,11 @@ def test_contact_locks_the_base_until_unlock(base, executor, wall):  # noqa: F81
     assert not r.ok and "Locked" in r.comment and "unlock" in r.comment
     r = base.move_jog(-100.0, 0.0, 0.0)                         # the servo is on: not the reason
     assert not r.ok and "needs it unlocked (call unlock)" in r.comment, r.comment
-    assert base.clear_alarm().ok and state(base) == VehicleState.LOCKED  # clear_alarm is not unlock
-    alarms = base.get_active_alarm(5).values["active_alarms"]
-    assert (AlarmCode.CONTACT, 1) in [(a[0], a[1]) for a in alarms]       # … and says why
+    r = base.clear_alarm()                      # 1.4.1: every alarm, the contact's too …
+    assert r.ok and base.get_active_alarm(5).values["num_of_active_alarm"] == 0
+    assert state_msg(base) == "Locked"          # … but Locked is left by unlock only (1.4.34)
+    assert r.comment == "still active: Locked until unlock (a contact)"
+    assert not base.move_forward(-200.0).ok
     assert base.unlock().ok and state(base) == VehicleState.READY
     assert base.move_forward(-200.0).ok                                   # back away
     settle(executor, base)
@@ -64,9 +69,40 @@ def test_contact_with_the_sensor_off_is_a_blockage(base, executor, wall):  # noq
     base.move_forward(500.0)
     run_until(executor, lambda: state(base) == VehicleState.STUCK, 8.0)
     settle(executor, base, 2.0)
-    assert base.move_forward(-300.0).ok and state(base) == VehicleState.BUSY   # moving on clears it
+    r = base.move_forward(-300.0)                                         # Ready only (1.4.17)
+    assert not r.ok and "the base is Stuck" in r.comment and "clear_alarm or stop" in r.comment
+    assert base.move_continuous_rel((-300.0, 0.0, 0.0)).ok                # a servo-on move …
+    assert state(base) == VehicleState.BUSY                                # … moving on clears it
     settle(executor, base)
     assert state(base) == VehicleState.READY and base.get_input(1).values["input"] == 0
+
+
+def test_a_distance_lag_alone_makes_the_base_stuck_within_the_stuck_time(base, executor, wall):  # noqa: F811
+    """Pushing into a wall: only the distance lags (the heading holds). It went Stuck only when
+    the move was about to end (11 s instead of 1 s) when the watch wanted both lags."""
+    ready(base)
+    assert base.move_forward(3000.0).ok                          # 10 s at 300 mm/s
+    run_until(executor, lambda: base.get_input(1).values["input"] == 1, 3.0)
+    took = run_until(executor, lambda: state(base) == VehicleState.STUCK, 2.0)
+    assert took < 1.5, took
+
+
+@pytest.mark.parametrize("move, lags", [("move_forward", "distance"), ("move_turn", "heading")])
+def test_either_lag_alone_makes_a_stalled_base_stuck_within_the_stuck_time(base, executor, move,  # noqa: F811
+                                                                           lags):
+    """Wheel motors too weak to move the base (a stalled drive): a long move forward lags in
+    distance only, a turn in place in heading only. Each must be Stuck soon after its lag
+    passes the limit, not when the move is about to end (8-10 s later)."""
+    for joint in WHEEL_JOINTS:
+        executor.world.limits[joint] = replace(executor.world.limits[joint], effort=0.05)
+    ready(base)
+    assert getattr(base, move)(3000.0 if move == "move_forward" else 360.0).ok
+    took = run_until(executor, lambda: state(base) == VehicleState.STUCK, 3.0)
+    assert took < 1.5, took
+    said = base.alarms.active()[-1].source                # "… (190 mm, 0.0° off): stopped"
+    mm, degree = (float(v.split()[0].rstrip("°")) for v in said.split("(")[1].split(",")[:2])
+    c = base.config
+    assert (mm > c.stuck_error, abs(degree) > c.stuck_angle) == (lags == "distance", lags == "heading"), said
 
 
 def test_a_contact_while_another_thread_plans_a_move_does_not_deadlock(base, executor):  # noqa: F811
@@ -116,7 +152,8 @@ def test_enabling_the_sensor_while_the_bumper_touches_locks_the_base(base, execu
     assert base.get_input(1).values["input"] == 1                          # touching
     assert base.set_digital_sensor_lock(True).ok
     run_until(executor, lambda: state(base) == VehicleState.LOCKED, 0.1)
-    assert base.unlock().ok and base.move_forward(-200.0).ok               # backs away unlocked
+    assert base.unlock().ok and state(base) == VehicleState.STUCK          # as before the lock
+    assert base.move_continuous_rel((-200.0, 0.0, 0.0)).ok                  # backs away unlocked
     settle(executor, base)
     assert state(base) == VehicleState.READY
 

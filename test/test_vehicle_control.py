@@ -115,14 +115,40 @@ def test_a_pause_during_the_stops_deceleration_holds_once_the_base_is_at_rest(ba
     assert base.device.completed == 1 and state(base) == VehicleState.READY
 
 
-def test_a_resume_during_the_stops_deceleration_undoes_a_pause_given_there(base, executor, trace):  # noqa: F811
+@pytest.mark.parametrize("resume_after", [0.0, 0.2])
+def test_a_resume_during_the_stops_deceleration_undoes_a_pause_given_there(base, executor, trace,  # noqa: F811
+                                                                           resume_after):
+    """… and does not speed the base up again: resumed, the stop's ramp ran back up to full
+    speed, and the clock then jumped to the stop's rest point (11 m/s² of deceleration against
+    the 1 m/s² limit)."""
     ready(base)
+    base.set_velocity((800.0, 45.0))
     base.move_forward(3000.0)
-    trace.until(lambda: base.odometry.v > 0.29, 5.0)
+    trace.until(lambda: base.odometry.v > 0.7, 5.0)
     base.stop()
-    assert base.pause().ok and base.resume().ok
+    rest, stopped_at = base.device.queued_end, len(trace.points) - 1
+    assert base.pause().ok
+    trace.step(resume_after)
+    assert base.resume().ok
     trace.until_idle()
+    trace.check(rest=rest)
+    speeds = [p.v for p in trace.points[stopped_at:]]
+    assert all(b <= a + 1e-9 for a, b in zip(speeds, speeds[1:])), "sped up during the stop"
     assert state(base) == VehicleState.READY
+
+
+def test_a_pause_before_the_move_starts_then_stop_lets_the_next_move_run(base, executor, trace):  # noqa: F811
+    """Paused before the simulation picked the move up, then stopped: the next move was
+    accepted and never ran (the device's rate stayed held at 0: moving for ever)."""
+    ready(base)
+    assert base.move_forward(500.0).ok
+    assert base.pause().ok and base.stop().ok
+    assert state(base) == VehicleState.READY
+    motion_id = base.move_forward(200.0).values["motion_id"]
+    trace.until_idle(10.0)
+    assert base.device.is_over(motion_id) and not base.device.was_discarded(motion_id)
+    assert position(base)[0] == pytest.approx(200.0, abs=5.0)
+    trace.check()
 
 
 # --- planning never blocks the control plane ------------------------------------------------

@@ -273,7 +273,9 @@ def test_battery_low_warning(base, executor):  # noqa: F811
     base.battery.charge = 0.25                        # ~45 V: below 46 V, above 44 V
     executor.step()
     assert state_msg(base) == "Warning-110"
-    assert base.move_forward(100.0).ok                # a warning does not refuse motion
+    r = base.move_forward(100.0)                      # Ready only: refused, and says why
+    assert not r.ok and "Warning-110" in r.comment and "the battery is back at 47 V" in r.comment
+    assert base.move_linear_abs((100.0, 0.0, 0.0)).ok  # a warning does not refuse servo-on moves
 
 
 # --- set_position --------------------------------------------------------------------------
@@ -353,16 +355,69 @@ def test_motion_is_refused_without_servo_or_while_locked(base, name, kwargs, sit
     assert base.device.last_id == 0
 
 
-@pytest.mark.parametrize("name, kwargs", [
+READY_ONLY_MOVES = [
     ("move_forward", dict(x=100.0)), ("move_turn", dict(theta=10.0)),
     ("move_linear_rel", dict(pos=(100.0, 0.0, 0.0))),
     ("move_circular_rel", dict(center_point=(0.0, 100.0), theta=10.0)),
-])
-def test_ready_only_moves_are_refused_while_busy(base, name, kwargs):
+]
+# how the base gets into a state other than Ready, and what the refusal says to leave it
+NOT_READY = {
+    "Busy": (lambda b: b.move_forward(300.0), "(wait, or call stop)"),
+    "Warning-104": (lambda b: b.set_output(77, 1, 1), "(it lasts until clear_alarm)"),
+    "Stuck": (lambda b: b._declare_stuck(0.5, 0.0, "could not follow its path"),
+              "(call clear_alarm or stop)"),
+}
+
+
+@pytest.mark.parametrize("name, kwargs", READY_ONLY_MOVES)
+@pytest.mark.parametrize("situation", sorted(NOT_READY))
+def test_ready_only_moves_are_refused_in_every_state_but_ready(base, executor, name, kwargs,  # noqa: F811
+                                                               situation):
+    """1.4.14, 1.4.17, 1.4.20, 1.4.21: Ready 状態以外で実行すると設定値を無視し，偽を返します. In
+    Warning-104 move_forward(100) drove 100.1 mm; in Stuck move_turn ran against the wall."""
     ready(base)
-    assert base.move_forward(300.0).ok
+    enter, remedy = NOT_READY[situation]
+    enter(base)
+    assert state_msg(base) == situation
+    ids = base.device.last_id
     r = getattr(base, name)(**kwargs)
-    assert not r.ok and "Busy" in r.comment and base.device.last_id == 1
+    assert not r.ok and f"the base is {situation}: {name} needs Ready" in r.comment, r.comment
+    assert r.comment.endswith(remedy) and base.device.last_id == ids
+
+
+@pytest.mark.parametrize("name, kwargs", READY_ONLY_MOVES)
+def test_ready_only_moves_given_while_paused_run_after_resume(base, executor, name, kwargs):  # noqa: F811
+    """1.4.22: 一時停止状態で入力された動作指令は内部に蓄積され…resume()実行後に実行されます."""
+    ready(base)
+    assert base.pause().ok and state(base) == VehicleState.PAUSED
+    r = getattr(base, name)(**kwargs)
+    assert r.ok and base.device.queue_length == 1
+    steps(executor, 0.5)
+    assert base.device.queue_length == 1 and state(base) == VehicleState.PAUSED
+    assert base.resume().ok
+    settle(executor, base)
+    assert base.device.completed == 1 and state(base) == VehicleState.READY
+
+
+@pytest.mark.parametrize("name, kwargs", [
+    ("move_forward", dict(x=0.0)), ("move_turn", dict(theta=0.0)),
+    ("move_linear_rel", dict(pos=(0.0, 0.0, 0.0))),
+    ("move_circular_rel", dict(center_point=(0.0, 100.0), theta=0.0)),
+    ("move_linear_abs", dict(pos=(0.0, 0.0, 0.0))),
+])
+def test_a_move_of_no_length_is_over_at_once(base, executor, name, kwargs):  # noqa: F811
+    """It kept the base Busy for the 400 ms settle, so an immediate Ready-only move was refused."""
+    ready(base)
+    motion_id = getattr(base, name)(**kwargs).values["motion_id"]
+    assert base.device.is_over(motion_id) and not base.device.was_discarded(motion_id)
+    assert state(base) == VehicleState.READY
+    moved = base.move_forward(100.0).values["motion_id"]     # no step needed in between
+    took = settle(executor, base)
+    assert base.device.completed == 2 and base.device.is_over(moved)
+    x, y, theta = base.device.queued_end.x, base.device.queued_end.y, base.device.queued_end.theta
+    assert base.move_forward(100.0).ok                       # behind a move: no settle of its own
+    assert base.move_linear_abs((1000.0 * x + 100.0, 1000.0 * y, math.degrees(theta))).ok
+    assert settle(executor, base) <= took + 2 * executor.dt and base.device.completed == 4
 
 
 def test_always_true_operations(base):

@@ -125,11 +125,12 @@ def test_clear_alarm_clears_every_alarm_and_a_present_cause_raises_its_own_again
     assert {a[0] for a in base.get_active_alarm(9).values["active_alarms"]} == {104, 110, 301}
     r = base.clear_alarm()
     assert r.ok
-    # the battery's cause is there, and so is the lock (only unlock leaves it): 301 says why,
-    # and so does the reply (it was true and silent: 全てのアラームを解除 read as done)
-    assert [a[0] for a in base.get_active_alarm(9).values["active_alarms"]] == [301, 110]
-    assert r.comment == ("still active: 301 until unlock; 110 until the battery is back at "
-                         "47 V and clear_alarm is called"), r.comment
+    # every alarm goes, the contact's 301 too; the battery's cause is there, and Locked is a
+    # state that only unlock leaves (1.4.34): the reply says both (it was true and silent:
+    # 全てのアラームを解除 read as done)
+    assert [a[0] for a in base.get_active_alarm(9).values["active_alarms"]] == [110]
+    assert r.comment == ("still active: 110 until the battery is back at 47 V and clear_alarm "
+                         "is called; Locked until unlock (a contact)"), r.comment
     assert state(base) == VehicleState.LOCKED
     base.battery.charge = 1.0
     assert base.unlock().ok
@@ -176,7 +177,8 @@ def test_a_move_into_a_wall_ends_stuck_and_not_completed(base, executor, distanc
     assert base.device.discard_reason(motion).startswith("a blockage: the base")   # and why
     assert position(base)[0] < 60.0
     assert AlarmCode.STUCK in [a[0] for a in base.get_active_alarm(5).values["active_alarms"]]
-    back = base.move_forward(-100.0).values["motion_id"]       # backs away
+    assert not base.move_forward(-100.0).ok                     # Ready only: not while Stuck
+    back = base.move_continuous_rel((-100.0, 0.0, 0.0)).values["motion_id"]   # backs away
     settle(executor, base, 5.0)
     assert not base.device.was_discarded(back) and state(base) == VehicleState.READY
 

@@ -119,19 +119,19 @@ class Control:
     # --- alarms -----------------------------------------------------------------------------
     @command
     def clear_alarm(self) -> Reply | None:
-        """Clear every alarm (1.4.1: 発生した全てのアラームを解除). One whose cause is still there
-        is raised again at once: a battery still within its hysteresis band of the level. Stuck
-        ends; Locked is a state that only unlock leaves, and its contact fault stays with it (a
-        client would see a locked base with no alarm to say why). The reply (always true) says
-        which alarms are still active and what ends each."""
-        self.alarms.clear(*(k for k in Kind if not (k is Kind.CONTACT and self.locked)))
+        """Clear every alarm, the contact fault 301 too (1.4.1: 発生した全てのアラームを解除します).
+        One whose cause is still there is raised again at once: a battery still within its
+        hysteresis band of the level. Stuck ends. Locked is a state, not an alarm, and stays:
+        table 7 keeps it "解除指令受信まで", and its release command is unlock (1.4.34:
+        接触検出停止状態から復帰します), as clearAlarm is the Alarm state's. The reply (always true)
+        says which alarms are still active and what ends each, and that the base stays Locked."""
+        self.alarms.clear(*Kind)
         self.stuck = False
         self._check_battery(self.battery.voltage)
-        left = self.alarms.active()
-        if not left:
-            return None
-        return Reply(comment="still active: " + "; ".join(f"{a.code} until {self._remedy(a.code)}"
-                                                          for a in left))
+        left = [f"{a.code} until {self._remedy(a.code)}" for a in self.alarms.active()]
+        if self.locked:
+            left.append("Locked until unlock (a contact)")
+        return Reply(comment="still active: " + "; ".join(left)) if left else None
 
     @query
     def get_active_alarm(self, num_of_alarm: int) -> dict:

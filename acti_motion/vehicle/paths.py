@@ -484,6 +484,7 @@ class TrackedBaseMotion:
         self.segments: list[tuple[float, Path]] = [(0.0, path)]
         self.kind = kind
         self.error = (0.0, 0.0)
+        self._settle = self.SETTLE if path.duration > 0.0 else 0.0   # a move of no length: none
 
     @property
     def path(self) -> Path:
@@ -496,7 +497,7 @@ class TrackedBaseMotion:
 
     @property
     def duration(self) -> float:
-        return self.t0 + self.path.duration + self.SETTLE
+        return self.t0 + self.path.duration + self._settle
 
     @property
     def path_end(self) -> float:
@@ -520,12 +521,14 @@ class TrackedBaseMotion:
     def splice(self, t: float, path: Path) -> None:
         """Follow `path` (which starts at the reference state at t) from motion time t on."""
         self.segments = [s for s in self.segments if s[0] < t] + [(t, path)]
+        if path.duration > 0.0:
+            self._settle = self.SETTLE
 
     def handover(self, t: float, path: Path, kind: str) -> "TrackedBaseMotion":
         """A plain tracked motion of another kind that follows this one's reference until t and
         `path` from then on (a continuous move or a jog taking over a running move)."""
         other = TrackedBaseMotion(self.odometry, path, kind)
-        other.segments = list(self.segments)
+        other.segments, other._settle = list(self.segments), self._settle
         other.splice(t, path)
         return other
 

@@ -22,7 +22,7 @@ from acti_motion.vehicle.paths import (Path, Pose2D, TrackedBaseMotion, arc, lin
 from acti_motion.vehicle.refusals import (Discarded, VehicleRefused, bounded_pair, finite_pose, invalid,
                                           planned, si_pair)
 from acti_motion.vehicle.sensing import VELOCITY_DRIVEN
-from acti_motion.vehicle.states import IDLE, SERVO_ON, STATE_STRINGS, VehicleState
+from acti_motion.vehicle.states import READY_ONLY, SERVO_ON, STATE_STRINGS, VehicleState
 
 LOOKAHEAD_STEPS = 2          # control periods ahead of now that an edit planned off-lock splices in …
 LOOKAHEAD_GROWTH = 4         # … times this for each attempt the device outran
@@ -84,34 +84,34 @@ class Planning:
     def move_forward(self, x: float) -> dict:
         distance = finite_number(x, "x") / 1000.0
         self._check_step(distance, 0.0, "x")
-        self._require(IDLE, "move_forward")
+        self._require(READY_ONLY, "move_forward")
         limits = self._limits()
 
         def plan(start: Pose2D) -> Path:
             self._check_goal(start.forward(distance), "the target")
             return line(start, distance, limits)
-        return self._submit(plan, "move_forward", IDLE)
+        return self._submit(plan, "move_forward", READY_ONLY)
 
     @planned
     def move_turn(self, theta: float) -> dict:
         angle = math.radians(finite_number(theta, "theta"))
         self._check_rotation(angle, "theta")
-        self._require(IDLE, "move_turn")
+        self._require(READY_ONLY, "move_turn")
         limits = self._limits()
-        return self._submit(lambda start: turn(start, angle, limits), "move_turn", IDLE)
+        return self._submit(lambda start: turn(start, angle, limits), "move_turn", READY_ONLY)
 
     @planned
     def move_linear_rel(self, pos: Any) -> dict:
         rel = finite_pose(pos)
         self._check_rotation(rel.theta, "pos.theta")
         self._check_step(rel.x, rel.y, "pos")
-        self._require(IDLE, "move_linear_rel")
+        self._require(READY_ONLY, "move_linear_rel")
         limits = self._limits()
 
         def plan(start: Pose2D) -> Path:
             goal = self._check_goal(start.compose(rel), "the target")
             return straight_to(start, goal, limits, False)
-        return self._submit(plan, "move_linear_rel", IDLE)
+        return self._submit(plan, "move_linear_rel", READY_ONLY)
 
     @planned
     def move_linear_abs(self, pos: Any) -> dict:
@@ -135,14 +135,14 @@ class Planning:
         if abs(cy) > self.config.work_area:
             raise invalid(f"center_point.y is {cy:.10g} mm: the centre must lie within the work area "
                           f"(±{self.config.work_area:g} mm)")
-        self._require(IDLE, "move_circular_rel")
+        self._require(READY_ONLY, "move_circular_rel")
         limits = self._limits()
 
         def plan(start: Pose2D) -> Path:
             path = arc(start, cy / 1000.0, angle, limits)
             self._check_goal(path.pose(path.duration), "the target")
             return path
-        return self._submit(plan, "move_circular_rel", IDLE)
+        return self._submit(plan, "move_circular_rel", READY_ONLY)
 
     @planned
     def move_cruise_abs(self, cruise_point: Any) -> dict:
@@ -349,15 +349,18 @@ class Planning:
 
     def _refuse_unless(self, s: VehicleState, allowed: tuple[VehicleState, ...], operation: str) -> None:
         if s not in allowed:
-            need = ("Ready" if allowed == IDLE
-                    else "it unlocked" if s == VehicleState.LOCKED
+            need = ("Ready (a Ready-only move)"
+                    if allowed == READY_ONLY else "it unlocked" if s == VehicleState.LOCKED
                     else "no active alarm" if s == VehicleState.ALARM else "the servo on")
             raise VehicleRefused(AlarmCode.WRONG_STATE,
-                                 f"the base is {STATE_STRINGS[s]}: {operation} needs {need}"
+                                 f"the base is {self.state_string(s)}: {operation} needs {need}"
                                  + self._how_to_leave(s))
 
-    @staticmethod
-    def _how_to_leave(s: VehicleState) -> str:
+    def _how_to_leave(self, s: VehicleState) -> str:
+        if s in (VehicleState.WARNING, VehicleState.STUCK):
+            warning = self._latest_warning() if s == VehicleState.WARNING else None
+            return (f" (it lasts until {self._remedy(warning.code)})" if warning is not None
+                    else " (call clear_alarm or stop)")
         return {VehicleState.UNPOWERED: " (call set_power(true), then set_servo(true))",
                 VehicleState.POWERED: " (call set_servo(true))",
                 VehicleState.ALARM: " (call clear_alarm)",

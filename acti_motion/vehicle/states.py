@@ -24,9 +24,13 @@ STATE_STRINGS = {
     VehicleState.AVOID: "Avoid", VehicleState.LOCKED: "Locked", VehicleState.POWERED: "Powered",
     VehicleState.UNPOWERED: "Unpowered",
 }
-# "Ready only" moves (moveForward, moveTurn, moveLinearRel, moveCircularRel) run from an idle base;
-# Paused is idle too, and the pause operation says commands given then are kept for resume.
-IDLE = (VehicleState.READY, VehicleState.WARNING, VehicleState.STUCK, VehicleState.PAUSED)
-# "Servo on only" moves (moveLinearAbs, moveContinuousRel, moveCruiseAbs, moveJog) also queue
-# behind a moving base; Alarm and Locked refuse every motion until clearAlarm / unlock.
-SERVO_ON = IDLE + (VehicleState.BUSY, VehicleState.AVOID)
+# "Ready only" moves (moveForward, moveTurn, moveLinearRel, moveCircularRel): 1.4.14, 1.4.20
+# "Ready 状態でのみ実行可能です。それ以外の場合は設定値を無視し，偽を返します" (1.4.17, 1.4.21 alike), so
+# Warning-### and Stuck refuse them too (clear_alarm or stop first). Paused takes them as the one
+# other state: 1.4.22 "一時停止状態で入力された動作指令は内部に蓄積され…resume()実行後に実行されます".
+READY_ONLY = (VehicleState.READY, VehicleState.PAUSED)
+# "Servo on only" moves (moveLinearAbs, moveContinuousRel, moveCruiseAbs, moveJog) also run from
+# Warning and Stuck and queue behind a moving base; Alarm and Locked refuse every motion until
+# clearAlarm / unlock.
+SERVO_ON = READY_ONLY + (VehicleState.WARNING, VehicleState.STUCK, VehicleState.BUSY,
+                         VehicleState.AVOID)
