@@ -58,7 +58,7 @@ class ControllerConfig:
     stopped_velocity_tolerance: float = ranged(0.01, 0.0, 10.0)
     # how long after its end a trajectory may take to be within the goal tolerance, where a goal's
     # goal_time_tolerance is 0 [s] (0: no limit, it waits)
-    goal_time_s: float = ranged(1.0, 0.0, 3600.0)
+    goal_time_s: float = ranged(0.0, 0.0, 3600.0)
     # feedback rate of follow_joint_trajectory [Hz]
     trajectory_feedback_rate_hz: float = ranged(25.0, 20.0, 1000.0)
     # how long a joint_jog moves the arm without another one before it decelerates [s]
