@@ -302,6 +302,20 @@ def test_tolerances_abort_with_their_codes(robot):
     assert result.error_code == Result.GOAL_TOLERANCE_VIOLATED and "joint2" in result.error_string
 
 
+def test_a_goal_is_rejected_while_a_program_runs(robot):
+    from acti_msgs.action import RunProgram
+    robot.ready()
+    programs = Actions(robot.ros, RunProgram, ARM + "run_program")
+    run = programs.send(text="60 DELAY")               # a program that only waits (60 s simulated)
+    q = robot.joints()
+    assert not robot.follow.offer(**moveit_goal(smooth(q, offset(q, 0.1), 1.0))).accepted
+    assert robot.logged("a STROLIC program runs")
+    programs.cancel(run)
+    assert programs.result(run)[0] == GoalStatus.STATUS_CANCELED
+    handle = robot.follow.send(**moveit_goal(smooth(q, offset(q, 0.1), 1.0)))   # then accepted
+    assert robot.follow.result(handle)[0] == GoalStatus.STATUS_SUCCEEDED
+
+
 # --- the gripper -------------------------------------------------------------------------------------
 def test_gripper_command_reaches_its_position(robot):
     robot.ready()
