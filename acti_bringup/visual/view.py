@@ -43,8 +43,7 @@ class ViewNode(Node):
         self.view = LiveView(reader, {"arm": arm, "base": vehicle}, URDF_PATH, c.view_host,
                              c.view_port, c.view_rate_hz, c.view_trail_points,
                              log=self.get_logger().info)
-        self.view.start()
-        self.get_logger().info(f"live view: {self.view.url}")
+        self.view.start()           # its URL: in the job's READY line, once the job serves
 
     def destroy_node(self) -> None:
         if self.view is not None:
