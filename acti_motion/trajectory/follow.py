@@ -79,6 +79,8 @@ class ArmTrajectories:
     def follow_plan(self, plan_of: PlanOf, label: str) -> tuple[int, TrajectoryMotion]:
         """`follow` for the knots plan_of(the arm's state where they begin, the time then)."""
         self.core._check_can_move()
+        if self.program_running():
+            raise self._busy("a STROLIC program runs")
         for _ in range(3):
             if self.running() is not None:
                 out = self.device.edit_planned(*self._replacement(plan_of, label))
@@ -123,11 +125,14 @@ class ArmTrajectories:
 
     def _check_idle(self) -> None:
         d = self.device
-        if d.busy or self.program_running():
-            what = ("a STROLIC program runs" if self.program_running() else
-                    f"ACT motions are running or queued ({d.queue_length + d.moving} of them)")
-            raise Refused(ReturnCode.STATUS_ERR, f"the arm is busy: {what}; a trajectory starts "
-                                                 "only from an idle arm (wait, or stop first)")
+        if d.busy:
+            raise self._busy(f"ACT motions are running or queued ({d.queue_length + d.moving} of "
+                             "them)")
+
+    @staticmethod
+    def _busy(what: str) -> Refused:
+        return Refused(ReturnCode.STATUS_ERR, f"the arm is busy: {what}; a trajectory starts only "
+                                              "from an idle arm (wait, or stop first)")
 
     def _replacement(self, plan_of: PlanOf, label: str) -> tuple[Callable, Callable]:
         """look and plan of `Device.edit_planned` for a trajectory replacing the running one."""
