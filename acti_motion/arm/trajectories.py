@@ -45,6 +45,7 @@ PATH_TOLERANCE_DEG = 0.01
 MAX_JOINT_STEP = math.radians(2.0)   # between IK samples of a CP path
 MAX_SAMPLES = 4000
 TOPPRA_GRID = 201
+SAMPLE_FLOOR = 4          # least intervals of the IK samples of a CP path (more where it strays)
 ELBOW_GRID_FLOOR = 4      # least intervals of the grid the elbow is carried on along a CP path
 
 
@@ -364,7 +365,7 @@ class CartesianPlanner:
     def _sample(self, path: CartesianPath, frames: Frames, start_q: np.ndarray,
                 elbow: _ElbowPlan) -> SplineJointPath:
         kin, ik = self.kin, _PathIK(self.kin, path, frames, elbow)
-        count = 1 + max(8, math.ceil(path.length / 0.02), math.ceil(path.angle / 0.1),
+        count = 1 + max(SAMPLE_FLOOR, math.ceil(path.length / 0.02), math.ceil(path.angle / 0.1),
                         math.ceil(abs(elbow.turn) / 0.1))
         ss = np.linspace(0.0, 1.0, min(count, 200))
         qs = ik.chain(ss, np.asarray(start_q, float))
