@@ -202,3 +202,22 @@ def test_a_jog_ramps_holds_and_stops_inside_the_soft_limit(executor, arm):  # no
     poly = check_limits(jog_plan(v, 5.0, 0.3, limits)(near, 0.0), limits)
     end = poly.state(poly.duration).positions[0]
     assert limits.upper[0] - 0.01 < end <= limits.upper[0] - SOFT_LIMIT_MARGIN_RAD + 1e-9
+
+
+def test_the_soft_limit_watch_stops_a_trajectory_with_an_alarm(executor, arm):  # noqa: F811
+    """A joint soft limit narrowed while the trajectory is paused (ACT 5.4.8): on resume the
+    watch stops it at the limit and raises alarm 0x4, as for any move."""
+    follower = ArmTrajectories(arm)
+    motion_id, _ = follower.follow(validate(four_points(0.3, 1.0), ARM_JOINTS, follower.now()), "t")
+    run_until(executor, lambda: arm.device.t > 0.5, 5.0)
+    assert arm.pause().ok
+    run_until(executor, lambda: arm.device.rate == 0.0, 5.0)
+    limits = arm.get_soft_limit_joint().values["soft_limit"]
+    here = math.degrees(arm.device.current.motion.at(arm.device.t).joints[0])
+    limits[0] = (here + 2.0, limits[0][1])                     # (upper, lower), degree
+    assert arm.set_soft_limit_joint(limits).ok
+    assert arm.resume().ok
+    rest(executor, arm)
+    assert [a.code for a in arm.alarms] == [0x4]
+    assert arm.device.discard_reason(motion_id).startswith("alarm 0x4")
+    assert math.degrees(arm.feedback_joints[0]) < here + 2.0 + 0.1
