@@ -10,7 +10,7 @@ setup(
     version="0.1.0",
     packages=find_packages(include=["acti_middle_node*", "vehicle_node*", "acti_bringup*",
                                     "acti_motion*", "acti_sim*", "acti_view*", "strolic*",
-                                    "roboline*"]),
+                                    "roboline*", "acti_record*"]),
     package_data={"roboline": ["grammar.lark"]},
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),

@@ -20,6 +20,7 @@ from sensor_msgs.msg import JointState
 
 from acti_bringup.visual.camera import SimCamera
 from acti_bringup.serving.parameters import declare_config
+from acti_bringup.recording.job import JobRecording
 from acti_bringup.priority import (FIFO_RANGE, NICE_RANGE, check_fifo_priority, freeze_heap,
                                    set_fifo, set_niceness)
 from acti_bringup.visual.robot_graph import RobotGraph
@@ -72,6 +73,7 @@ class Simulation:
         set_niceness(c.nice, node.get_logger().warning)
         check_fifo_priority(c.control_fifo_priority)       # here, not on the simulation thread
         self._log = node.get_logger()
+        self.recording = JobRecording(node)
         self.world = World(time_step=1.0 / c.rate_hz)
         self.executor = MotionExecutor(self.world, c.real_time_factor, alive=node.context.ok)
         if c.clock_rate_hz > 0:
@@ -129,6 +131,7 @@ class Simulation:
                    if hasattr(n, plane)]
         for helper in helpers:
             planes.add(helper.plane, [helper])
+        self.recording.introspect([*nodes, *helpers])
         freeze_heap()
         self.executor.start(prepare=self._schedule_control_loop)
         planes.outbox.put(self._schedule_control_loop)       # it carries the loop's messages
@@ -144,6 +147,7 @@ class Simulation:
                 n.destroy_node()
             self.world.close()
             rclpy.try_shutdown()
+            self.recording.stop()
         for error in planes.errors():
             raise error
         if self.executor.failed:

@@ -73,10 +73,14 @@ def action_server(host: Node, action_type: Any, name: str, execute: Callable,
                   **callbacks: Any) -> ActionServer:
     """An ActionServer whose goal, cancel and result services keep as many requests as the
     services do (SERVICE_QOS): with rclpy's 10, a burst of 20 goals lost 10 of them without any
-    answer, not even the rejection the goal bound promises."""
-    return ActionServer(host, action_type, name, execute, goal_service_qos_profile=SERVICE_QOS,
-                        result_service_qos_profile=SERVICE_QOS,
-                        cancel_service_qos_profile=SERVICE_QOS, **callbacks)
+    answer, not even the rejection the goal bound promises. Its name is kept as `action_name`
+    (rclpy keeps none): the action's introspection publishes under it
+    (`acti_bringup.recording.introspection`)."""
+    server = ActionServer(host, action_type, name, execute, goal_service_qos_profile=SERVICE_QOS,
+                          result_service_qos_profile=SERVICE_QOS,
+                          cancel_service_qos_profile=SERVICE_QOS, **callbacks)
+    server.action_name = name
+    return server
 
 
 def serve_operations(node: Node, motion: Plane, core: Any,

@@ -1,0 +1,210 @@
+"""Writing a recording: MCAP files as rosbag2's MCAP storage writes them, one after another when
+a size or duration limit splits the recording.
+
+What rosbag2 (Jazzy) writes and this writes too: profile `ros2`; one schema per type, named
+`pkg/msg/Name`, encoding `ros2msg`, the complete definition (`acti_record.definitions`); one
+channel per topic, message encoding `cdr`, metadata `offered_qos_profiles` (the publishers' QoS,
+YAML, metadata version 9) and `topic_type_hash` (RIHS01); log time = receive time, publish time
+= the publisher's send time (ns since the epoch); a `rosbag2` metadata record holding the bag's
+metadata YAML. Chunks are small and reach the disk as soon as they are full, and the recorder
+flushes the one in progress every FLUSH_PERIOD_S: a process killed with -9 leaves a file whose complete chunks can all be read
+(`acti_record.reading`)."""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from typing import Any
+
+import yaml
+from mcap.writer import CompressionType, Writer
+
+PROFILE = "ros2"
+SCHEMA_ENCODING = "ros2msg"
+MESSAGE_ENCODING = "cdr"
+LIBRARY = "acti_ros2 acti_record"
+METADATA_VERSION = 9              # rosbag2 Jazzy's BagMetadata version
+CHUNK_BYTES = 256 * 1024
+FLUSH_PERIOD_S = 1.0
+COMPRESSIONS = {"none": CompressionType.NONE, "zstd": CompressionType.ZSTD,
+                "lz4": CompressionType.LZ4}
+
+
+@dataclass(frozen=True)
+class Topic:
+    """A recorded topic: its name, type (`pkg/msg/Name`), complete definition (empty when no
+    installed file defines it), publishers' QoS (rosbag2's keys, `qos_profile`) and type hash."""
+    name: str
+    type: str
+    definition: str
+    qos_profiles: tuple[dict, ...] = ()
+    type_hash: str = ""
+
+
+def qos_profile(history: str, depth: int, reliability: str, durability: str,
+                deadline_ns: int, lifespan_ns: int, liveliness: str, lease_ns: int) -> dict:
+    """One offered QoS profile as rosbag2 (metadata version 9) writes it: policies by name,
+    durations as sec/nsec (infinite: 9223372036 s 854775807 ns)."""
+    return {"history": history, "depth": depth, "reliability": reliability,
+            "durability": durability, "deadline": _duration(deadline_ns),
+            "lifespan": _duration(lifespan_ns), "liveliness": liveliness,
+            "liveliness_lease_duration": _duration(lease_ns),
+            "avoid_ros_namespace_conventions": False}
+
+
+def _duration(ns: int) -> dict:
+    return {"sec": ns // 1_000_000_000, "nsec": ns % 1_000_000_000}
+
+
+def dump_yaml(value: Any) -> str:
+    return yaml.safe_dump(value, sort_keys=False, default_flow_style=False)
+
+
+class _WriteThrough:
+    """The file under the MCAP writer, unbuffered: a finished chunk is in the file at once."""
+
+    def __init__(self, path: str) -> None:
+        self._file = open(path, "wb", buffering=0)
+
+    def write(self, data: bytes) -> int:
+        view = memoryview(data)
+        while view:
+            view = view[self._file.write(view):]
+        return len(data)
+
+    def tell(self) -> int:
+        return self._file.tell()
+
+    def flush(self) -> None:
+        pass
+
+    def close(self) -> None:
+        self._file.close()
+
+
+@dataclass
+class _Counts:
+    messages: int = 0
+    first_ns: int = 0
+    last_ns: int = 0
+    per_topic: dict[str, int] = field(default_factory=dict)
+
+    def add(self, topic: str, log_ns: int) -> None:
+        if not self.messages:
+            self.first_ns = log_ns
+        self.messages += 1
+        self.first_ns, self.last_ns = min(self.first_ns, log_ns), max(self.last_ns, log_ns)
+        self.per_topic[topic] = self.per_topic.get(topic, 0) + 1
+
+
+class McapFile:
+    """One MCAP file of a recording."""
+
+    def __init__(self, path: str, compression: str = "none", chunk_bytes: int = CHUNK_BYTES) -> None:
+        if compression not in COMPRESSIONS:
+            raise ValueError(f"compression {compression!r}: use one of {', '.join(COMPRESSIONS)}")
+        self.path = path
+        self._stream = _WriteThrough(path)
+        self._writer = Writer(self._stream, chunk_size=chunk_bytes,
+                              compression=COMPRESSIONS[compression], enable_crcs=True)
+        self._writer.start(profile=PROFILE, library=LIBRARY)
+        self._schemas: dict[str, int] = {}
+        self._channels: dict[str, tuple[int, Topic]] = {}
+        self.counts = _Counts()
+
+    def channel(self, topic: Topic) -> int:
+        """The channel id of `topic`, registered (with its schema) on first use."""
+        known = self._channels.get(topic.name)
+        if known is not None:
+            return known[0]
+        schema = self._schemas.get(topic.type)
+        if schema is None:
+            encoding = SCHEMA_ENCODING if topic.definition else ""
+            schema = self._schemas[topic.type] = self._writer.register_schema(
+                topic.type, encoding, topic.definition.encode())
+        metadata = {"offered_qos_profiles": dump_yaml(list(topic.qos_profiles)),
+                    "topic_type_hash": topic.type_hash}
+        channel = self._writer.register_channel(topic.name, MESSAGE_ENCODING, schema, metadata)
+        self._channels[topic.name] = (channel, topic)
+        return channel
+
+    def write(self, topic: Topic, data: bytes, log_ns: int, publish_ns: int) -> None:
+        self._writer.add_message(self.channel(topic), log_ns, data, publish_ns)
+        self.counts.add(topic.name, log_ns)
+
+    def flush(self) -> None:
+        """Write the chunk in progress to the file (the recorder does every FLUSH_PERIOD_S)."""
+        self._writer.flush()
+
+    @property
+    def size(self) -> int:
+        return self._stream.tell()
+
+    def close(self) -> None:
+        """The rosbag2 metadata record, then MCAP's summary and footer."""
+        self._writer.add_metadata("rosbag2", {"serialized_metadata": dump_yaml(self._metadata())})
+        self._writer.finish()
+        self._stream.close()
+
+    def _metadata(self) -> dict:
+        """rosbag2's BagMetadata of this file alone."""
+        c, name = self.counts, os.path.basename(self.path)
+        start, duration = {"nanoseconds_since_epoch": c.first_ns}, {"nanoseconds": c.last_ns - c.first_ns}
+        return {
+            "version": METADATA_VERSION, "storage_identifier": "mcap",
+            "duration": duration, "starting_time": start, "message_count": c.messages,
+            "topics_with_message_count": [
+                {"topic_metadata": {"name": t.name, "type": t.type,
+                                    "serialization_format": MESSAGE_ENCODING,
+                                    "offered_qos_profiles": list(t.qos_profiles),
+                                    "type_description_hash": t.type_hash},
+                 "message_count": c.per_topic.get(t.name, 0)}
+                for _, t in self._channels.values()],
+            "compression_format": "", "compression_mode": "",
+            "relative_file_paths": [name],
+            "files": [{"path": name, "starting_time": start, "duration": duration,
+                       "message_count": c.messages}],
+            "custom_data": {}, "ros_distro": "jazzy",
+        }
+
+
+class Recording:
+    """The files of one recording. Without limits one file, `path`; with a size (bytes) or
+    duration (s) limit, `stem_0.mcap`, `stem_1.mcap` … as rosbag2 names its split files, the
+    next one started when the current one reaches a limit."""
+
+    def __init__(self, path: str, max_bytes: int = 0, max_duration_s: float = 0.0,
+                 compression: str = "none") -> None:
+        if max_bytes < 0 or max_duration_s < 0:
+            raise ValueError("the size and duration limits must be 0 (none) or positive")
+        self.path, self.max_bytes, self.max_duration_ns = path, max_bytes, int(max_duration_s * 1e9)
+        self.compression = compression
+        self.paths: list[str] = []
+        self.messages = 0
+        self._file = self._open()
+
+    def _open(self) -> McapFile:
+        split = self.max_bytes or self.max_duration_ns
+        stem = self.path.removesuffix(".mcap")
+        path = f"{stem}_{len(self.paths)}.mcap" if split else self.path
+        self.paths.append(path)
+        return McapFile(path, self.compression)
+
+    def write(self, topic: Topic, data: bytes, log_ns: int, publish_ns: int) -> None:
+        if self._full(log_ns):
+            self._file.close()
+            self._file = self._open()
+        self._file.write(topic, data, log_ns, publish_ns)
+        self.messages += 1
+
+    def _full(self, log_ns: int) -> bool:
+        counts = self._file.counts
+        if not counts.messages:
+            return False
+        return bool(self.max_bytes and self._file.size >= self.max_bytes
+                    or self.max_duration_ns and log_ns - counts.first_ns >= self.max_duration_ns)
+
+    def flush(self) -> None:
+        self._file.flush()
+
+    def close(self) -> None:
+        self._file.close()

@@ -1,0 +1,180 @@
+"""Recording and replaying the job over DDS: the quick tour's calls recorded by the job's own
+`record` parameter and replayed against a fresh job with every answer equal; topics read back
+with rosbags as they were published and republished with their timing; a recorder killed with
+-9 leaves a readable file; what is not a recording is refused in one line."""
+import os
+import signal
+import subprocess
+import sys
+
+import pytest
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rosbags.highlevel import AnyReader
+from rosbags.typesys import Stores, get_typestore
+from std_msgs.msg import String
+
+from acti_bringup.harness import ROOT, Actions, NodeProcess, wait_until
+from acti_msgs import srv
+from acti_msgs.action import Move, RunProgram, VehicleWaitMotion, WaitMotion
+from acti_msgs.msg import CarPosWithElbow, VehiclePosition
+from acti_record.reading import BadRecording, read_recording
+from ros_harness import TEST_RATE
+
+ARM, BASE = "/acti_middle_node/", "/vehicle_node/"
+PROGRAM = "30 JSPEED DROP Ar[R8 10 30 0 -60 0 60 0] ADRIVE DROP -1 $WAIT"
+LASTING = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
+                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+def job(tmp_path, name: str, *params: str) -> NodeProcess:
+    return NodeProcess("acti_bringup", str(tmp_path / f"{name}.log"), TEST_RATE,
+                       "view_enabled:=false", *params)
+
+
+def run(module: str, *args: str, timeout: float = 240.0) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", module, *args], cwd=ROOT, capture_output=True,
+                          text=True, timeout=timeout)
+
+
+def recorder(path: str, *topics: str) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", "acti_bringup.record", path, *topics],
+                            cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+
+
+
+def tour(ros) -> int:
+    """The README quick tour's calls, each read taken at rest (a read while moving depends on
+    timing); the number of calls made, a goal's two (its goal and its result) counted."""
+    def call(srv_type, name, **fields):
+        reply = ros.call(srv_type, name, **fields)
+        assert getattr(reply, "success", True), reply
+        assert getattr(getattr(reply, "return_id", None), "id", 0) == 0, reply
+
+    def finish(actions, **goal):
+        status, _ = actions.result(actions.send(**goal))
+        assert status == 4          # SUCCEEDED
+    arm_wait = Actions(ros, WaitMotion, ARM + "wait_motion")
+    base_wait = Actions(ros, VehicleWaitMotion, BASE + "wait_motion")
+    call(srv.ServoON, ARM + "servo_on")
+    call(srv.SetSpeedJoint, ARM + "set_speed_joint", spd_ratio=50)
+    call(srv.MovePTPJointAbs, ARM + "move_ptp_joint_abs",
+         joint_points=[10.0, 20.0, 30.0, -40.0, 50.0, 60.0, 70.0])
+    finish(arm_wait, motion_id=0)
+    call(srv.GetState, ARM + "get_state")
+    call(srv.GetFeedbackPosJoint, ARM + "get_feedback_pos_joint")
+    call(srv.VehicleSetPower, BASE + "set_power", on_off=True)
+    call(srv.VehicleSetServo, BASE + "set_servo", on_off=True)
+    call(srv.VehicleGetState, BASE + "get_state")
+    call(srv.VehicleMoveForward, BASE + "move_forward", x=500.0)
+    finish(base_wait, motion_id=0)
+    call(srv.VehicleMoveTurn, BASE + "move_turn", theta=90.0)
+    finish(base_wait, motion_id=0)
+    call(srv.VehicleMoveLinearAbs, BASE + "move_linear_abs",
+         pos=VehiclePosition(x=1000.0, y=500.0, theta=0.0))
+    finish(base_wait, motion_id=0)
+    call(srv.VehicleGetPosition, BASE + "get_position")
+    call(srv.VehicleGetActiveAlarm, BASE + "get_active_alarm", num_of_alarm=5)
+    call(srv.SetSpeedCartesian, ARM + "set_speed_cartesian", spd_ratio=50)
+    call(srv.MoveLinearCartesianRel, ARM + "move_linear_cartesian_rel", car_point=CarPosWithElbow(
+        car_pos=[1.0, 0.0, 0.0, 100.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, -150.0], elbow=0.0))
+    finish(arm_wait, motion_id=0)
+    finish(Actions(ros, Move, ARM + "move"), kind="move_ptp_joint_abs",
+           joint_points=[0.0, 30.0, 0.0, -60.0, 0.0, 60.0, 0.0])
+    finish(Actions(ros, RunProgram, ARM + "run_program"), text=PROGRAM)
+    return 15 + 2 * 6
+
+
+def test_the_recorded_tour_replayed_against_a_fresh_job_answers_every_call_equally(
+        ros, tmp_path):
+    path = str(tmp_path / "tour.mcap")
+    first = job(tmp_path, "first", f"record:={path}")
+    try:
+        made = tour(ros)
+    finally:
+        assert first.stop() in (0, -signal.SIGINT), first.log()
+    assert "Traceback" not in first.log(), first.log()
+    fresh = job(tmp_path, "fresh")
+    try:
+        replayed = run("acti_bringup.replay", path, "--requests")
+    finally:
+        fresh.stop()
+    out = replayed.stdout + replayed.stderr
+    assert replayed.returncode == 0, out
+    calls = int(out.split(" calls, ")[0].rsplit("\n", 1)[-1])
+    assert calls >= made and out.rstrip().endswith(f"{calls} calls, 0 differences"), out
+    assert out.count(": equal") == calls, out       # every answer was compared
+
+
+def test_topics_read_back_with_rosbags_as_published_and_are_republished(ros, tmp_path):
+    path = str(tmp_path / "topics.mcap")
+    sent = [f"message {i}: " + "x" * (i % 50) for i in range(300)]
+    rec = recorder(path, "/record_test")
+    # transient local: the recorder gets them all, however late it matches (as rosbag2 would)
+    publisher = ros.node.create_publisher(String, "/record_test", LASTING)
+    try:
+        for text in sent:
+            publisher.publish(String(data=text))
+        assert wait_until(lambda: len(_flushed(path)) == len(sent), 60.0), _flushed(path)
+    finally:
+        rec.send_signal(signal.SIGINT)
+        assert rec.wait(timeout=30) == 0
+        ros.node.destroy_publisher(publisher)
+    assert f"recorded {len(sent)} messages" in rec.stdout.read()
+    with AnyReader([tmp_path / "topics.mcap"],
+                   default_typestore=get_typestore(Stores.ROS2_JAZZY)) as bag:
+        (connection,) = bag.connections
+        assert (connection.topic, connection.msgtype) == ("/record_test", "std_msgs/msg/String")
+        read = [bag.deserialize(raw, c.msgtype).data for c, _, raw in bag.messages()]
+    assert read == sent
+
+    received = []
+    subscription = ros.node.create_subscription(String, "/record_test",
+                                                lambda m: received.append(m.data), LASTING)
+    replay = subprocess.Popen([sys.executable, "-m", "acti_bringup.replay", path, "--rate", "2",
+                               "--wait-for-subscribers", "30"],
+                              cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        assert ros.spin_until(lambda: replay.poll() is not None and len(received) >= len(sent),
+                              60.0)
+    finally:
+        replay.kill()
+        ros.node.destroy_subscription(subscription)
+    assert replay.wait() == 0 and received == sent, replay.stdout.read()
+
+
+def _flushed(path: str):
+    """What the file holds so far (the recorder flushes every second)."""
+    try:
+        return read_recording(path).messages
+    except BadRecording:            # not there yet, or no chunk yet
+        return []
+
+
+
+def test_a_recorder_killed_with_9_leaves_a_file_that_reads_up_to_its_last_chunk(ros, tmp_path):
+    moving = job(tmp_path, "moving")
+    path = str(tmp_path / "killed.mcap")
+    rec = recorder(path)                     # every topic: the job's clock, joints, TF …
+    try:
+        assert wait_until(lambda: os.path.exists(path) and os.path.getsize(path) > 1_000_000,
+                          120.0), rec
+    finally:
+        rec.kill()
+        rec.wait()
+        moving.stop()
+    contents = read_recording(path)
+    assert "ends early" in contents.problem
+    topics = {c.topic for c in contents.channels}
+    assert {"/clock", "/joint_states", "/tf"} <= topics and len(contents.messages) > 1000
+    shown = run("acti_bringup.replay", path, "--topics", "/none")   # reads it, says what is lost
+    assert shown.returncode == 0 and "ends early" in shown.stderr, shown.stdout + shown.stderr
+
+
+@pytest.mark.parametrize("content", [b"", b"plain text, not a recording\n", b"\x89MCAP0\r\n\x01"])
+def test_what_is_not_a_recording_is_refused_with_one_line(tmp_path, content):
+    bad = tmp_path / "bad.mcap"
+    bad.write_bytes(content)
+    for args in ([str(bad)], [str(bad), "--requests"], [str(tmp_path / "missing.mcap")]):
+        refused = run("acti_bringup.replay", *args, timeout=60)
+        assert refused.returncode == 2 and refused.stdout == "", refused
+        assert refused.stderr.count("\n") == 1 and "Traceback" not in refused.stderr
