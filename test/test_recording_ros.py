@@ -43,8 +43,9 @@ def recorder(path: str, *topics: str) -> subprocess.Popen:
 
 
 def tour(ros) -> int:
-    """The README quick tour's calls, each read taken at rest (a read while moving depends on
-    timing); the number of calls made, a goal's two (its goal and its result) counted."""
+    """The README quick tour's calls, each read taken at rest (a read while moving, or while the
+    joints settle after a move, depends on timing): the arm's after the base's moves; the
+    number of calls made, a goal's two (its goal and its result) counted."""
     def call(srv_type, name, **fields):
         reply = ros.call(srv_type, name, **fields)
         assert getattr(reply, "success", True), reply
@@ -60,8 +61,6 @@ def tour(ros) -> int:
     call(srv.MovePTPJointAbs, ARM + "move_ptp_joint_abs",
          joint_points=[10.0, 20.0, 30.0, -40.0, 50.0, 60.0, 70.0])
     finish(arm_wait, motion_id=0)
-    call(srv.GetState, ARM + "get_state")
-    call(srv.GetFeedbackPosJoint, ARM + "get_feedback_pos_joint")
     call(srv.VehicleSetPower, BASE + "set_power", on_off=True)
     call(srv.VehicleSetServo, BASE + "set_servo", on_off=True)
     call(srv.VehicleGetState, BASE + "get_state")
@@ -74,6 +73,8 @@ def tour(ros) -> int:
     finish(base_wait, motion_id=0)
     call(srv.VehicleGetPosition, BASE + "get_position")
     call(srv.VehicleGetActiveAlarm, BASE + "get_active_alarm", num_of_alarm=5)
+    call(srv.GetState, ARM + "get_state")          # the arm's reads, seconds after it stopped
+    call(srv.GetFeedbackPosJoint, ARM + "get_feedback_pos_joint")
     call(srv.SetSpeedCartesian, ARM + "set_speed_cartesian", spd_ratio=50)
     call(srv.MoveLinearCartesianRel, ARM + "move_linear_cartesian_rel", car_point=CarPosWithElbow(
         car_pos=[1.0, 0.0, 0.0, 100.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, -150.0], elbow=0.0))
@@ -135,7 +136,7 @@ def test_topics_read_back_with_rosbags_as_published_and_are_republished(ros, tmp
                               cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         assert ros.spin_until(lambda: replay.poll() is not None and len(received) >= len(sent),
-                              60.0)
+                              60.0), (replay.poll(), len(received))
     finally:
         replay.kill()
         ros.node.destroy_subscription(subscription)

@@ -7,6 +7,7 @@ import array
 import time
 from typing import Any, Callable
 
+from rclpy.duration import Duration
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
@@ -19,6 +20,7 @@ from acti_record.reading import Channel, Contents
 
 SERVICE_WAIT_S = 30.0
 REPUBLISH_DEPTH = 1000
+ACKED_WAIT_S = 5.0
 
 
 def plain(value: Any) -> Any:
@@ -41,8 +43,9 @@ def is_hidden(topic: str) -> bool:
 def republish(node: Node, contents: Contents, wanted: Callable[[str], bool], rate: float,
               stopped: Callable[[], bool], subscribers_wait_s: float = 0.0) -> int:
     """Publish the recorded messages of the wanted topics again, each when its log time comes
-    (scaled by 1/rate), after waiting up to `subscribers_wait_s` for a subscriber on each;
-    the count published."""
+    (scaled by 1/rate), after waiting up to `subscribers_wait_s` for a subscriber on each, and
+    wait (up to ACKED_WAIT_S) until the reliable subscribers have them all; the count
+    published."""
     publishers: dict[str, Any] = {}
     for channel in contents.channels:
         if wanted(channel.topic):
@@ -65,6 +68,8 @@ def republish(node: Node, contents: Contents, wanted: Callable[[str], bool], rat
         if stopped():
             return count
         publishers[m.channel.topic].publish(m.data)     # the recorded bytes, as they were
+    for publisher in publishers.values():                # delivered before the process ends
+        publisher.wait_for_all_acked(Duration(seconds=ACKED_WAIT_S))
     return len(messages)
 
 
