@@ -277,7 +277,7 @@ def test_a_goal_is_rejected_while_act_moves_are_queued(robot):
                       joint_points=[10.0] + [0.0] * 6).return_id.id == 0
     q = robot.joints()
     assert not robot.follow.offer(**moveit_goal(smooth(q, offset(q, 0.1), 1.0))).accepted
-    assert robot.logged("ACT motions are running or queued")
+    assert robot.logged(r"1 motion\(s\) \(ACT moves, gripper commands\) running or queued")
     robot.call("stop", srv.Stop)
 
 

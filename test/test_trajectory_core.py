@@ -146,7 +146,7 @@ def test_stop_pause_and_busy_govern_it(executor, arm):  # noqa: F811
     assert arm.move_ptp_joint_rel([5.0] + [0.0] * 6).ok
     q = arm.device.hold.joints
     req = RequestedTrajectory(list(ARM_JOINTS), [RequestedPoint(1.0, list(q))])
-    with pytest.raises(Refused, match="ACT motions are running or queued"):
+    with pytest.raises(Refused, match=r"motion\(s\) \(ACT moves, gripper commands\) running"):
         follower.follow(validate(req, ARM_JOINTS, follower.now()), "t")
 
 

@@ -126,8 +126,8 @@ class ArmTrajectories:
     def _check_idle(self) -> None:
         d = self.device
         if d.busy:
-            raise self._busy(f"ACT motions are running or queued ({d.queue_length + d.moving} of "
-                             "them)")
+            raise self._busy(f"{d.queue_length + d.moving} motion(s) (ACT moves, gripper "
+                             "commands) running or queued")
 
     @staticmethod
     def _busy(what: str) -> Refused:
