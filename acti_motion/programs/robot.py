@@ -362,6 +362,23 @@ class RobotHost(Host):
         except StrolicError:
             pass
 
+    def hold(self, vm: VM, debugger) -> None:
+        """At a breakpoint (`debugger.LineVM`): once the program's motions so far have ended,
+        wait for a step or continue; a stop, cancel or alarm meanwhile is the exception as ever."""
+        self.check(vm)
+        while self.pending:
+            self.sleep(POLL)
+            self.check(vm)
+        debugger.arrive()
+        previous, self.state = self.state, "at breakpoint"
+        try:
+            while not debugger.wait_for_go(0):
+                self.sleep(POLL)
+                self.check(vm)
+        finally:
+            debugger.leave()
+            self.state = previous
+
     def wait_motions(self, vm: VM) -> None:
         """After the program's end: wait until its motions are over (exceptions as `check`)."""
         self.state = "finishing motions"

@@ -13,13 +13,16 @@ from typing import Any, Callable, Iterable
 from dataclasses import dataclass, field
 
 from acti_motion.arm.core import ArmCore
+from acti_motion.programs.debugger import Debugger, LineVM
 from acti_motion.programs.robot import ProgramDefaults, RobotHost
+from roboline import Program
 from strolic.codec import decode
 from strolic.errors import ExceptionKind as K, StrolicError
 from strolic.host import MemoryIO
 from strolic.literals import format_value
 from strolic.process import State
 from strolic.text import assemble, format_code
+from strolic.variables import visible_scopes
 from strolic.vm import VM
 
 
@@ -34,6 +37,8 @@ class Status(enum.IntEnum):
 @dataclass
 class Progress:
     program_counter: int = -1     # byte offset of the program's next code (process 0)
+    line: int = 0                 # RoboLine: its source line, and the breakpoints
+    breakpoints: list[int] = field(default_factory=list)
     instructions: int = 0
     state: str = "starting"
     message: str = ""             # PAUSE's message while paused
@@ -52,9 +57,13 @@ class ProgramResult:
     console: list[str] = field(default_factory=list)   # TRACE, warnings, flags, PAUSE messages
     instructions: int = 0
     duration: float = 0.0                              # simulated seconds
+    line: int = 0                                      # RoboLine: the exception's source line
+    explained: str = ""                                # … and the report that names it
 
     @property
     def report(self) -> str:
+        if self.explained:
+            return self.explained
         return self.error.report() if self.error is not None else ""
 
 
@@ -65,15 +74,17 @@ RESULT_CHARS = 1 << 20     # … and the characters formatted for all of them
 CHARS_PER_BYTE = 6         # the most a datum's byte takes as text (\\xNN; "-128 " in an I1 array)
 
 
-def load(program: bytes | str) -> list:
+def load(program: bytes | str | Program) -> list:
     """Decoded codes of a program in the text form (str) or as code (bytes); StrolicError when
     it does not assemble or decode, or is longer than MAX_PROGRAM (a 2 MB text takes seconds
     to assemble). Any other failure of the assembler or decoder is invalid code too: a flaw
     there must not look like a fault of the controller."""
-    if len(program) > MAX_PROGRAM:
+    if not isinstance(program, Program) and len(program) > MAX_PROGRAM:
         raise StrolicError(K.INVALID_CODE, f"the program is {len(program)} "
                            f"{'characters' if isinstance(program, str) else 'bytes'} long: at most "
                            f"{MAX_PROGRAM} (1 MiB)")
+    if isinstance(program, Program):
+        return decode(program.code)
     try:
         return decode(assemble(program) if isinstance(program, str) else bytes(program))
     except StrolicError:
@@ -124,16 +135,22 @@ def shown_output(output: list[bytes]) -> list[str]:
 
 
 class ProgramRun:
-    """A program run on `arm`; `step` (tests) advances the simulation while the program waits."""
+    """A program run on `arm`; `step` (tests) advances the simulation while the program waits.
+    A RoboLine `Program` runs with its source map: progress and exceptions name source lines,
+    and `debugger` (breakpoints, step) and `variable` work."""
 
-    def __init__(self, arm: ArmCore, program: bytes | str, *, io: MemoryIO | None = None,
-                 step: Callable[[], None] | None = None,
+    def __init__(self, arm: ArmCore, program: bytes | str | Program, *,
+                 io: MemoryIO | None = None, step: Callable[[], None] | None = None,
                  defaults: ProgramDefaults | None = None, budget: int | None = None,
-                 echo: bool = False) -> None:
+                 echo: bool = False, breakpoints: Iterable[int] = (), stepping: bool = False,
+                 host: RobotHost | None = None) -> None:
         self.arm = arm
         self.program = program
-        self.host = RobotHost(arm, io, step=step, defaults=defaults, echo=echo)
-        self.vm = VM(self.host)
+        self.host = host or RobotHost(arm, io, step=step, defaults=defaults, echo=echo)
+        self.source = program if isinstance(program, Program) else None
+        self.debugger = (Debugger(program, breakpoints, stepping) if self.source is not None
+                         else None)
+        self.vm = LineVM(self.host, self.debugger) if self.debugger else VM(self.host)
         self.budget = budget
         self.result: ProgramResult | None = None
         self._thread: threading.Thread | None = None
@@ -171,6 +188,9 @@ class ProgramRun:
             status, error, shown_stack(vm.main.stack) if vm.main else [],
             shown_output(host.output),
             host.lines + dropped, vm.executed, host.now() - start)
+        if self.source is not None and error is not None:
+            self.result.line = self.source.line_at(error.offset)
+            self.result.explained = self.source.explain(error)
         return self.result
 
     def start(self) -> None:
@@ -210,5 +230,27 @@ class ProgramRun:
             out.program_counter = vm.program_offset(main, frame, offset)
             if host.state == "running" and main.state is State.WAITING:
                 out.state = "waiting"
+        if self.debugger is not None:
+            out.line = self.debugger.line
+            out.breakpoints = sorted(self.debugger.breakpoints)
         out.motion_id, out.motion_label, out.progress, out.queue_length = self.arm.motion_status()
         return out
+
+    def variable(self, name: str) -> tuple[str, str]:
+        """A RoboLine variable's type and value (text form), the innermost binding visible to
+        the program where it stands; KeyError with the reason when there is none."""
+        if self.source is None:
+            raise KeyError("the program is not a RoboLine program: it has no variable names")
+        candidates = [s for s in self.source.symbols.values() if s.name.upper() == name.upper()]
+        if not candidates:
+            raise KeyError(f"{name} is no variable of the program")
+        main = self.vm.main
+        for scope in visible_scopes(main.scopes if main is not None else [self.vm.globals]):
+            for symbol in candidates:
+                registrations = scope.table.get(symbol.key)
+                if registrations:
+                    try:
+                        return symbol.type, format_value(registrations[-1].value())
+                    except StrolicError:
+                        raise KeyError(f"{name} has no value yet") from None
+        raise KeyError(f"{name} is not in scope where the program stands")
