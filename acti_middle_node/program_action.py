@@ -11,7 +11,8 @@ A RoboLine program (the goal's `source` and `points`) runs with its source map: 
 exception name source lines; ~/program_debug (breakpoints, step, continue) and
 ~/program_variable (a variable by name) act on it while it runs, on the control plane: they only
 set flags or read values. ~/check_program runs a program against a fresh arm in simulated time
-(`acti_motion.programs.check`) on a thread of its own, awaited on the goal plane.
+(`acti_motion.programs.check`) on the goal plane: for its seconds, the feedback of a running
+program waits, the control plane does not.
 """
 from __future__ import annotations
 
@@ -183,28 +184,17 @@ class ProgramAction:
             response.message = str(error.args[0])
         return response
 
-    # --- check before motion: a thread of its own, awaited on the goal plane ----------------
-    async def _check(self, request: CheckProgram.Request,
-                     response: CheckProgram.Response) -> CheckProgram.Response:
+    # --- check before motion: on the goal plane (seconds of simulation; never the control plane)
+    def _check(self, request: CheckProgram.Request,
+               response: CheckProgram.Response) -> CheckProgram.Response:
         try:
             program = compiled(request.source, request.source_name, request.points)
+            result = check_program(program, self.core, self.defaults, request.budget or 600.0)
         except SourceError as error:
             response.message = error.report()
             return response
-        outcome: list = []
-
-        def work() -> None:
-            try:
-                outcome.append(check_program(program, self.core, self.defaults,
-                                             request.budget or 600.0))
-            except Exception as e:          # a bug or the world going away: an answer
-                outcome.append(e)
-            self.watch.poke()
-        threading.Thread(target=work, name="program-check", daemon=True).start()
-        await self.watch.until(lambda: True if outcome else None, lambda: None)
-        result = outcome[0]
-        if isinstance(result, Exception):
-            response.message = f"the check failed: {type(result).__name__}: {result}"
+        except Exception as e:          # a bug or the world going away: an answer
+            response.message = f"the check failed: {type(e).__name__}: {e}"
             return response
         response.success, response.message = result.success, result.message
         response.total_time, response.cut = result.total_time, result.cut

@@ -17,12 +17,12 @@ from __future__ import annotations
 
 from lark import Token, Tree
 
-from strolic.codec import CodeKind, decode, decode_function, encode
+from strolic.codec import CodeKind, encode_code
 from strolic.codes import I2, I4, R8, Function, Num, Str, Vec, make_number
 
 from .builtins import NUMERIC
 from .commands import Commands
-from .emitter import FIRST_KEY, Body, Routine, named, position
+from .emitter import FIRST_KEY, Body, Encoded, Routine, named, position
 from .parser import parse
 from .points import Point
 from .program import FAIL_CODE, Program, Symbol
@@ -62,10 +62,9 @@ class Compiler(Commands):
         for statement in main:
             for dim in statement.find_data("dim"):
                 self.declare_dim(dim, self.globals)
-        bodies = [(routine, *self.routine_body(routine)) for routine in self.routines.values()]
+        bodies = [(routine, self.routine_body(routine)) for routine in self.routines.values()]
         main_key = self.new_key(None)
-        main_code, main_lines = self.main_body(main)
-        return self.link(bodies, main_key, main_code, main_lines)
+        return self.link(bodies, main_key, self.main_body(main))
 
     def declare_dim(self, dim: Tree, table: dict[str, Symbol]) -> None:
         names, type_name, _ = dim.children[1:-2], dim.children[-2], dim.children[-1]
@@ -85,7 +84,7 @@ class Compiler(Commands):
         self.routines[name.upper()] = Routine(str(name), self.new_key(name), parameters, result,
                                               item)
 
-    def routine_body(self, routine: Routine) -> tuple[bytes, list[int]]:
+    def routine_body(self, routine: Routine) -> Encoded:
         self.routine, self.locals, self.body = routine, {}, Body()
         self.stop_on_error = True
         tree = routine.tree
@@ -129,7 +128,7 @@ class Compiler(Commands):
                 self.push(DEFAULTS[symbol.type])
                 self.op("STORE")
 
-    def main_body(self, statements: list[Tree]) -> tuple[bytes, list[int]]:
+    def main_body(self, statements: list[Tree]) -> Encoded:
         self.body = Body()
         self.stop_on_error = True
         self.prepare_hidden(statements, self.globals)
@@ -138,8 +137,8 @@ class Compiler(Commands):
         self.line = 0
         return self.finish_body()
 
-    def link(self, bodies: list, main_key: int, main_code: bytes,
-             main_lines: list[int]) -> Program:
+    def link(self, bodies: list[tuple[Routine, Encoded]], main_key: int,
+             main: Encoded) -> Program:
         """The program: declarations, taught points, the routines, the main body and its call."""
         self.body, self.line = Body(), 0
         symbols = list(self.globals.values())
@@ -152,37 +151,39 @@ class Compiler(Commands):
             self.suppressed(self.globals[point.name.upper()].key)
             self.push(point.value)
             self.op("STORE")
-        nested: list[list[int]] = []
-        for routine, code, lines in bodies:
+        for routine, body in bodies:
             self.line = position(routine.tree)[0]
             self.suppressed(routine.key)
             self.op("FDEF")
-            self.push(Function(code))
-            nested.append(lines)
+            self.push(Function(body.code))
         self.line = 0
         self.suppressed(main_key)
         self.op("FDEF")
-        self.push(Function(main_code))
-        nested.append(main_lines)
+        self.push(Function(main.code))
         self.evaluate(main_key)
-        code = encode(self.body.codes)
-        table = self.source_map(code, self.body.lines, nested)
+        parts = [encode_code(code) for code in self.body.codes]
+        table = self.source_map(parts, self.body.lines, [body for _, body in bodies] + [main])
         symbols = {name: s for name, s in self.globals.items()}
         for routine_locals in self._locals_seen:
             symbols.update(routine_locals)
-        return Program(code, self.source, table, symbols)
+        return Program(b"".join(parts), self.source, table, symbols)
 
-    @staticmethod
-    def source_map(code: bytes, lines: list[int], nested: list[list[int]]) -> dict[int, int]:
+    def source_map(self, parts: list[bytes], lines: list[int],
+                   nested: list[Encoded]) -> dict[int, int]:
         """Offset of every code → its line: the top-level codes and, inside each function datum
         (in order), the codes of its body."""
         table: dict[int, int] = {}
         bodies = iter(nested)
-        for top, line in zip(decode(code), lines):
-            table[top.offset] = line
-            if top.kind is CodeKind.DATA and isinstance(top.value, Function):
-                for inner, inner_line in zip(decode_function(top.value), next(bodies)):
-                    table[inner.offset] = inner_line
+        offset = 0
+        for code, part, line in zip(self.body.codes, parts, lines):
+            table[offset] = line
+            if code.kind is CodeKind.DATA and isinstance(code.value, Function):
+                body = next(bodies)
+                start = offset + len(part) - len(body.code)
+                for size, inner_line in zip(body.sizes, body.lines):
+                    table[start] = inner_line
+                    start += size
+            offset += len(part)
         return table
 
     # ---- statements ---------------------------------------------------------------------------

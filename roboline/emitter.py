@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 from lark import Token, Tree
 
-from strolic.codec import Code, CodeKind, encode
+from strolic.codec import Code, CodeKind, encode_code
 from strolic.codes import I2, Num, UserCode
 from strolic.opcodes import BY_MNEMONIC
 from strolic.text import resolve_labels
@@ -36,6 +36,14 @@ class Body:
     labels: dict[str, int] = field(default_factory=dict)
     references: list[tuple[int, str, int]] = field(default_factory=list)
     label_lines: dict[str, int] = field(default_factory=dict)
+
+
+@dataclass
+class Encoded:
+    """A function body's bytes, and the line and byte size of each of its codes."""
+    code: bytes
+    lines: list[int]
+    sizes: list[int]
 
 
 def named(type_: str) -> str:
@@ -130,7 +138,7 @@ class Emitter:
         self.push(Num(I2, 0))
         self.op(mnemonic)
 
-    def finish_body(self) -> tuple[bytes, list[int]]:
+    def finish_body(self) -> Encoded:
         """The body's bytes (ending in END) and the lines of its codes."""
         self.op("END")
         for _, label, _ in self.body.references:
@@ -138,7 +146,8 @@ class Emitter:
                 raise self.error(self.body.label_lines[label], f"label {label} is not defined "
                                  "in this routine")
         codes = resolve_labels(self.body.codes, self.body.labels, self.body.references)
-        return encode(codes), self.body.lines
+        parts = [encode_code(code) for code in codes]
+        return Encoded(b"".join(parts), self.body.lines, [len(part) for part in parts])
 
     def check_count(self, args: list, count: int, node) -> None:
         if len(args) != count:
