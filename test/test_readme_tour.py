@@ -8,8 +8,7 @@ prints has that field with that value), `name: value` (every such line of what i
 that value) or `name<value`; a number ending in … is the printed one rounded to the digits shown.
 Prose is not checked, but for the phrases of PROSE_CHECKS. A comment this test cannot check
 fails it. The `ros2` of `tools/bin` (tools/ros2_lite.py: the real CLI is not on PyPI) runs the
-lines; the two commands that run until Ctrl-C get a bound (`topic pub -t 10`, `topic echo
---once`)."""
+lines; the jog, which runs until Ctrl-C, gets a bound (`topic pub -t 10`)."""
 from __future__ import annotations
 
 import math
@@ -52,9 +51,8 @@ def first_bash_block(path: str, heading: str) -> str:
 
 
 def bounded(script: str) -> str:
-    """The commands that run until Ctrl-C, made to end by themselves."""
-    script = re.sub(r"^ros2 topic pub ", "ros2 topic pub -t 10 ", script, flags=re.M)
-    return re.sub(r"^ros2 topic echo ", "ros2 topic echo --once ", script, flags=re.M)
+    """The command that runs until Ctrl-C, made to end by itself."""
+    return re.sub(r"^ros2 topic pub ", "ros2 topic pub -t 10 ", script, flags=re.M)
 
 
 def commands(block: str) -> list[Command]:
