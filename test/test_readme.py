@@ -1,6 +1,7 @@
 """The README stays a page for users: at most 300 lines, no measurements or commit hashes (those
-live in docs/performance.md), and every link of the READMEs leads to a file that exists (the
-reference moved to docs/; a link left behind would point nowhere)."""
+live in docs/performance.md), and every link of the READMEs and of docs/ leads to a file that
+exists (the reference moved to docs/; a link left behind would point nowhere)."""
+import glob
 import os
 import re
 
@@ -25,8 +26,9 @@ def test_the_readme_names_no_commit():
     assert not hashes, f"commits belong in docs/performance.md: {hashes}"
 
 
-def test_every_link_of_the_readmes_leads_to_a_file():
-    pages = [README, os.path.join(ROOT, "strolic", "README.md")]
+def test_every_link_of_the_readmes_and_docs_leads_to_a_file():
+    pages = [README, os.path.join(ROOT, "strolic", "README.md"),
+             *glob.glob(os.path.join(ROOT, "docs", "*.md"))]
     broken = [f"{os.path.relpath(page, ROOT)}: {target}" for page in pages
               for target in LINK.findall(read(page))
               if "://" not in target
