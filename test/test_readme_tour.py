@@ -128,7 +128,7 @@ def moved_by_hand(outputs: list[str]) -> None:
     cruise_end = [out for out in outputs if re.search(r"^\s*x: ", out, flags=re.M)][-1]
     ended = {k: float(v) for k, v in re.findall(r"^\s*([xy]): (\S+)$", cruise_end, flags=re.M)}
     now = {k: float(field_values(responses(outputs[-1])[0], k)[0]) for k in "xy"}
-    assert math.hypot(now["x"] - ended["x"], now["y"] - ended["y"]) > 100.0, (ended, now)
+    assert math.hypot(now["x"] - ended["x"], now["y"] - ended["y"]) > 10.0, (ended, now)
 
 
 PROSE_CHECKS = {"drives the base while it publishes": moved_by_hand}
