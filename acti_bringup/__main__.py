@@ -28,7 +28,8 @@ def nodes() -> tuple:
     from vehicle_node.node import VehicleNode
     arm = ArmNode()
     vehicle = VehicleNode(simulation=arm.simulation)
-    return arm, vehicle, ViewNode(arm.simulation, arm.core, vehicle.core)
+    return arm, vehicle, ViewNode(arm.simulation, arm.core, vehicle.core,
+                                  program=arm.programs.shown)
 
 
 if __name__ == "__main__":

@@ -29,6 +29,7 @@ from acti_bringup.serving.adapter import SERVICE_QOS, Plane, action_server
 from acti_bringup.serving.conversions import fill
 from acti_bringup.serving.waiting import Watch
 from acti_motion.arm.core import ArmCore
+from acti_view.program import ProgramShown
 from acti_motion.programs.check import check_program
 from acti_motion.programs.run import MAX_PROGRAM, ProgramRun, Status
 from acti_motion.programs.robot import ProgramDefaults, RobotIO
@@ -78,6 +79,15 @@ class ProgramAction:
                 return GoalResponse.REJECT
             self._busy = True
             return GoalResponse.ACCEPT
+
+    def shown(self) -> ProgramShown | None:
+        """The RoboLine program that runs, where it stands and its breakpoints (the live view)."""
+        run = self._current
+        if run is None or run.debugger is None:
+            return None
+        debugger = run.debugger
+        return ProgramShown(run.source, debugger.line, sorted(debugger.breakpoints),
+                            run.host.state)
 
     def _cancel(self, _goal: Any) -> CancelResponse:
         """At once: the program's waits end and the arm starts to decelerate now."""

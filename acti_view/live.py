@@ -23,6 +23,7 @@ from viser.extras import ViserUrdf
 
 from acti_view.controls import CONTROLS, Control, press
 from acti_view.follow import EYE, LOOK_AT, RobotFollow
+from acti_view.program import ProgramSource, program_markdown
 from acti_view.sample import ArmPanel, BasePanel, Reader, ViewSample, state_words
 
 TRAIL_STEP_M = 0.002          # a trail gets a point when the robot moved this far
@@ -56,8 +57,10 @@ class LiveView:
 
     def __init__(self, reader: Reader, cores: dict[str, Any], urdf_path: str, host: str,
                  port: int, rate_hz: float, trail_points: int,
-                 log: Callable[[str], None] = print) -> None:
+                 log: Callable[[str], None] = print,
+                 program: ProgramSource | None = None) -> None:
         self.reader = reader
+        self.program = program        # the RoboLine program that runs, for its panel
         self.cores = cores
         self.period = 1.0 / rate_hz
         self.log = log
@@ -105,6 +108,9 @@ class LiveView:
                     button = gui.add_button(control.label,
                                             color="red" if control.method == "stop" else None)
                     button.on_click(self._on_press(control))
+        if self.program is not None:
+            with gui.add_folder("Program"):
+                self.program_panel = gui.add_markdown(program_markdown(None))
 
     def _on_press(self, control: Control) -> Callable[[Any], None]:
         def on_click(_event: Any) -> None:
@@ -196,6 +202,10 @@ class LiveView:
             text = panel_text(s.arm, s.base)
             if text != self._panel_text:
                 self.status.content = self._panel_text = text
+            if self.program is not None:
+                shown = program_markdown(self.program())
+                if shown != self.program_panel.content:
+                    self.program_panel.content = shown
 
 
 def panel_text(arm: ArmPanel | None, base: BasePanel | None) -> str:

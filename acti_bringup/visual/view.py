@@ -13,6 +13,7 @@ from acti_motion.arm.core import ArmCore
 from acti_motion.vehicle.core import VehicleCore
 from acti_sim.world import URDF_PATH
 from acti_view.live import LiveView
+from acti_view.program import ProgramSource
 from acti_view.sample import Reader, WorldSampler
 
 
@@ -31,7 +32,8 @@ class ViewConfig:
 class ViewNode(Node):
     """`acti_view`: serves the view of the arm and base of `simulation` (when enabled)."""
 
-    def __init__(self, simulation: Simulation, arm: ArmCore, vehicle: VehicleCore) -> None:
+    def __init__(self, simulation: Simulation, arm: ArmCore, vehicle: VehicleCore,
+                 program: ProgramSource | None = None) -> None:
         super().__init__("acti_view")
         self.config = c = declare_config(self, ViewConfig)
         self.view: LiveView | None = None
@@ -42,7 +44,7 @@ class ViewNode(Node):
         reader = Reader(WorldSampler(simulation.executor, every), arm, vehicle)
         self.view = LiveView(reader, {"arm": arm, "base": vehicle}, URDF_PATH, c.view_host,
                              c.view_port, c.view_rate_hz, c.view_trail_points,
-                             log=self.get_logger().info)
+                             log=self.get_logger().info, program=program)
         self.view.start()           # its URL: in the job's READY line, once the job serves
 
     def destroy_node(self) -> None:

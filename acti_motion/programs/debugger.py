@@ -58,6 +58,11 @@ class Debugger:
         self.stepping = False
         self._go.set()
 
+    @property
+    def waiting(self) -> bool:
+        """Held at a line, and not yet told to go on."""
+        return self.held and not self._go.is_set()
+
     def stops_at(self, line: int) -> bool:
         return self.stepping or line in self.breakpoints
 
