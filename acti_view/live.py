@@ -100,6 +100,9 @@ class LiveView:
         gui = self.server.gui
         self.status = gui.add_markdown("")
         self.last_command = gui.add_markdown("*no command yet*")
+        if self.program is not None:
+            with gui.add_folder("Program"):
+                self.program_panel = gui.add_markdown(program_markdown(None))
         for device in ("arm", "base"):
             if device not in self.cores:
                 continue
@@ -108,9 +111,6 @@ class LiveView:
                     button = gui.add_button(control.label,
                                             color="red" if control.method == "stop" else None)
                     button.on_click(self._on_press(control))
-        if self.program is not None:
-            with gui.add_folder("Program"):
-                self.program_panel = gui.add_markdown(program_markdown(None))
 
     def _on_press(self, control: Control) -> Callable[[Any], None]:
         def on_click(_event: Any) -> None:
