@@ -29,7 +29,7 @@ def nodes() -> tuple:
     arm = ArmNode()
     vehicle = VehicleNode(simulation=arm.simulation)
     return arm, vehicle, ViewNode(arm.simulation, arm.core, vehicle.core,
-                                  program=arm.programs.shown)
+                                  program=arm.programs.shown, scan=vehicle.scan)
 
 
 if __name__ == "__main__":

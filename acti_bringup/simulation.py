@@ -7,6 +7,7 @@ time, joints and transforms in its namespace: /robotN/clock, /robotN/joint_state
 (/clock, /tf … alone)."""
 from __future__ import annotations
 
+import os
 import sys
 from dataclasses import dataclass
 from typing import Callable
@@ -28,7 +29,8 @@ from acti_bringup.serving.spinning import Planes, build_or_exit, init, wait_for_
 from acti_bringup.serving.waiting import end_goals
 from acti_motion.config_fields import ranged
 from acti_motion.executor import MotionExecutor
-from acti_sim.world import World
+from acti_sim.surroundings.worldfile import WorldSpec, build_world, load_world
+from acti_sim.world import ROOT, World
 
 SWITCH_INTERVAL_S = 2e-4
 # control rates PyBullet's robot keeps stable (10 Hz: 100 ms steps) and the 2-core machine keeps
@@ -36,8 +38,14 @@ SWITCH_INTERVAL_S = 2e-4
 RATE_RANGE_HZ = (10.0, 2000.0)
 
 
+DEFAULT_WORLD = "config/worlds/empty.yaml"
+
+
 @dataclass
 class SimulationConfig:
+    # the world file: static obstacles (docs/world.md), a path (relative: to the project's
+    # directory first, then to the working directory)
+    world: str = DEFAULT_WORLD
     # physics and control rate [Hz] (250: a 4 ms cycle)
     rate_hz: float = ranged(250.0, *RATE_RANGE_HZ)
     # simulated seconds per wall second (0: as fast as it can)
@@ -55,6 +63,15 @@ class SimulationConfig:
     # machine starved a service call for 30 s). Needs CAP_SYS_NICE (root); not applied when
     # real_time_factor is 0
     control_fifo_priority: int = ranged(0, *FIFO_RANGE)
+
+
+def world_path(path: str) -> str:
+    """A relative world file path is looked for in the project's directory first (the shipped
+    config/worlds/), then where the process was started."""
+    if os.path.isabs(path):
+        return path
+    shipped = os.path.join(ROOT, path)
+    return shipped if os.path.exists(shipped) else os.path.abspath(path)
 
 
 def stamp(node_time: float) -> Time:
@@ -75,6 +92,8 @@ class Simulation:
         self._log = node.get_logger()
         self.recording = JobRecording(node)
         self.world = World(time_step=1.0 / c.rate_hz)
+        self.surroundings: WorldSpec = load_world(world_path(c.world))
+        build_world(self.world, self.surroundings)
         self.executor = MotionExecutor(self.world, c.real_time_factor, alive=node.context.ok)
         if c.clock_rate_hz > 0:
             self._clock = node.create_publisher(Clock, "clock", 10)
@@ -86,12 +105,13 @@ class Simulation:
         self.camera = SimCamera(node, self.executor, self.now)
 
     def publish_at(self, rate_hz: float, publish: Callable[[World], None],
-                   *publishers: Publisher) -> None:
+                   *publishers: Publisher, wanted: Callable[[], bool] = lambda: False) -> None:
         """Run publish(world) on the simulation thread at about rate_hz while one of `publishers`
-        has a subscriber. Building messages nobody receives was most of an idle robot's Python
-        work; a volatile topic without subscribers shows nothing, so skipping it changes nothing."""
+        has a subscriber (or `wanted()` says so: the view shows it). Building messages nobody
+        receives was most of an idle robot's Python work; a volatile topic without subscribers
+        shows nothing, so skipping it changes nothing."""
         def received() -> bool:
-            return any(p.get_subscription_count() for p in publishers)
+            return any(p.get_subscription_count() for p in publishers) or wanted()
 
         def listened(world: World) -> None:
             if received():

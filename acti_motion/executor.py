@@ -105,6 +105,8 @@ class Device:
         self._rate_target = 1.0
         self._ramp = 1.0
         self._stop_at: float | None = None
+        self._cap = 1.0            # the highest rate allowed now (`cap_rate`)
+        self._cap_ramp = 1.0
         self._stops = 0            # stops asked for (`arrival`, `stopped_since`)
         self.paused = False
         self.generation = 0
@@ -275,6 +277,14 @@ class Device:
                 self._set_rate(0.0, ramp)
             self.queued_end = self._end_of_queue()
 
+    def cap_rate(self, cap: float, ramp: float) -> None:
+        """Let the motion's clock run at most `cap` times its pace (a speed limit that keeps the
+        path), ramping there over `ramp` s per unit of rate; 1.0 lifts it. Pause, resume and stop
+        keep their own targets below it."""
+        with self.lock:
+            self._cap = min(max(cap, 0.0), 1.0)
+            self._cap_ramp = max(ramp, 1e-6)
+
     def edit(self, fn: Callable[["Device"], Any]) -> Any:
         """Run fn(device) under the lock and return its result: a core changes its motions in place
         there (the current one from time `t` on, queued ones whole, or the rest point `hold`)
@@ -429,11 +439,14 @@ class Device:
                 self._fail(e, t0)
 
     def _next_rate(self, dt: float) -> float:
-        """The rate after one more step of `dt`: it ramps linearly towards its target."""
+        """The rate after one more step of `dt`: it ramps linearly towards its target (or
+        towards the cap, over the cap's ramp, where that is lower: `cap_rate`)."""
         r0 = self.rate
-        step = dt / self._ramp if self._ramp > 0 else 1.0
-        return min(self._rate_target, r0 + step) if r0 < self._rate_target \
-            else max(self._rate_target, r0 - step)
+        target, ramp = self._rate_target, self._ramp
+        if self._cap < target:
+            target, ramp = self._cap, self._cap_ramp
+        step = dt / ramp if ramp > 0 else 1.0
+        return min(target, r0 + step) if r0 < target else max(target, r0 - step)
 
     def rest_time_after_next_step(self, ramp: float, dt: float) -> float:
         """The current motion's clock time where it would rest if a stop over `ramp` seconds

@@ -18,15 +18,22 @@ with output_silenced():         # its build time, printed on import
     import pybullet
 import pybullet_data
 
-URDF_PATH = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
-                         "urdf", "mobile_manipulator.urdf")
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))      # the project's directory
+URDF_PATH = os.path.join(ROOT, "urdf", "mobile_manipulator.urdf")
 ARM_JOINTS = tuple(f"joint{i}" for i in range(1, 8))
 GRIPPER_JOINTS = ("gripper_finger_left_joint", "gripper_finger_right_joint")
 WHEEL_JOINTS = ("left_wheel_joint", "right_wheel_joint")
 BUMPER_LINK = "bumper"
 CASTER_LINKS = ("front_caster", "rear_caster")
+# the links that make the base's footprint on the floor (the arm is above it)
+BASE_LINKS = ("base_link", BUMPER_LINK, *CASTER_LINKS, "left_wheel", "right_wheel")
 
 HELD = "held"                          # the wheels' motor target while `hold_wheels`
+# The robot's links collide in this group (PyBullet: static bodies are group 2, dynamic ones 1):
+# rays cast by the robot's own sensors leave it out, and see everything else (`cast_rays`).
+ROBOT_GROUP = 4
+EVERYTHING_BUT_ROBOTS = -1 ^ ROBOT_GROUP
+OBSTACLE_RGBA = (0.62, 0.55, 0.45, 1.0)
 
 class PhysicsClient:
     """PyBullet's functions bound to one physics client. pybullet_utils' BulletClient binds them
@@ -84,6 +91,9 @@ class World:
         # Free all motors; every driven joint gets an explicit motor below.
         for j in self._joint.values():
             p.setJointMotorControl2(self.robot, j, pybullet.VELOCITY_CONTROL, force=0)
+        for link in (-1, *self._joint.values()):
+            p.setCollisionFilterGroupMask(self.robot, link, ROBOT_GROUP, -1)
+        self.obstacles: list[int] = []
         # Sprung casters: frictionless, and compliant so that the driven wheels carry the weight
         # (rigid casters took ~90 % of it and the wheels slipped: odometry drifted in turns).
         for name in CASTER_LINKS:
@@ -113,6 +123,16 @@ class World:
         self.set_wheel_velocities(0.0, 0.0)
         self.wheel_radius = 0.10
         self.wheel_separation = 0.50
+        self.footprint = self._footprint()
+
+    def _footprint(self) -> tuple[float, float, float, float]:
+        """(x min, x max, y min, y max) of the base's links around base_link [m], from their
+        collision shapes as loaded (the robot at the origin, facing +x)."""
+        (bx, by, _), _ = self.base_link_pose()
+        boxes = [self._p.getAABB(self.robot, -1 if name == "base_link" else self._link[name])
+                 for name in BASE_LINKS]
+        return (min(b[0][0] for b in boxes) - bx, max(b[1][0] for b in boxes) - bx,
+                min(b[0][1] for b in boxes) - by, max(b[1][1] for b in boxes) - by)
 
     def close(self) -> None:
         self._p.disconnect()
@@ -266,8 +286,37 @@ class World:
         return False
 
     def add_box(self, position: tuple[float, float, float], half_extents: tuple[float, float, float],
-                mass: float = 0.0) -> int:
-        """An obstacle (static when mass is 0), for contact tests and demos."""
+                mass: float = 0.0, yaw: float = 0.0) -> int:
+        """An obstacle (static when mass is 0), for contact tests, demos and world files."""
         p = self._p
         shape = p.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half_extents)
-        return p.createMultiBody(mass, shape, -1, position)
+        look = p.createVisualShape(pybullet.GEOM_BOX, halfExtents=half_extents,
+                                   rgbaColor=OBSTACLE_RGBA)
+        body = p.createMultiBody(mass, shape, look, position,
+                                 p.getQuaternionFromEuler((0.0, 0.0, yaw)))
+        self.obstacles.append(body)
+        return body
+
+    def add_cylinder(self, position: tuple[float, float, float], radius: float,
+                     height: float) -> int:
+        """A static upright cylinder (world files)."""
+        p = self._p
+        shape = p.createCollisionShape(pybullet.GEOM_CYLINDER, radius=radius, height=height)
+        look = p.createVisualShape(pybullet.GEOM_CYLINDER, radius=radius, length=height,
+                                   rgbaColor=OBSTACLE_RGBA)
+        body = p.createMultiBody(0.0, shape, look, position)
+        self.obstacles.append(body)
+        return body
+
+    def link_pose(self, name: str) -> tuple[tuple[float, float, float],
+                                             tuple[float, float, float, float]]:
+        """Position (m) and quaternion (x, y, z, w) of a URDF link's frame in the world."""
+        state = self._p.getLinkState(self.robot, self._link[name])
+        return tuple(state[4]), tuple(state[5])
+
+    def cast_rays(self, starts: list, ends: list) -> np.ndarray:
+        """For each ray from starts[i] to ends[i] (m, world), the fraction of its length at
+        which it first hits something other than a robot's own links (1.0: nothing), by one
+        batched PyBullet ray cast."""
+        hits = self._p.rayTestBatch(starts, ends, collisionFilterMask=EVERYTHING_BUT_ROBOTS)
+        return np.fromiter((h[2] if h[0] >= 0 else 1.0 for h in hits), float, len(hits))

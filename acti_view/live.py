@@ -9,6 +9,7 @@ state; buttons from `controls.CONTROLS`.
 from __future__ import annotations
 
 import logging
+import math
 import socket
 import threading
 import time
@@ -58,9 +59,13 @@ class LiveView:
     def __init__(self, reader: Reader, cores: dict[str, Any], urdf_path: str, host: str,
                  port: int, rate_hz: float, trail_points: int,
                  log: Callable[[str], None] = print,
-                 program: ProgramSource | None = None) -> None:
+                 program: ProgramSource | None = None, layers: tuple = ()) -> None:
+        """`layers`: more of the scene (`acti_view.surroundings.SurroundingsLayer`): each is
+        added once (`add(scene)`), updated each frame (`update(scene, base pose x, y, yaw)`)
+        and told whether a page is open (`watched(bool)`)."""
         self.reader = reader
         self.program = program        # the RoboLine program that runs, for its panel
+        self.layers = layers
         self.cores = cores
         self.period = 1.0 / rate_hz
         self.log = log
@@ -76,6 +81,8 @@ class LiveView:
         scene = self.server.scene
         scene.add_grid("/floor", width=10.0, height=10.0, cell_size=0.25, section_size=1.0)
         self.robot = scene.add_frame("/robot", show_axes=False)
+        for layer in layers:
+            layer.add(scene)
         self.urdf = ViserUrdf(self.server, Path(urdf_path), root_node_name="/robot")
         self._joint_names = self.urdf.get_actuated_joint_names()
         self.trail: deque[np.ndarray] = deque(maxlen=trail_points)
@@ -156,6 +163,8 @@ class LiveView:
         time nobody looked restarts the trails: nothing was recorded meanwhile, and a line from
         the last point before to the first after would cut across whatever the robot did."""
         self.reader.sampler.active = watched
+        for layer in self.layers:
+            layer.watched(watched)
         if watched and not self._watched:
             self._restart_trails()
         self._watched = watched
@@ -197,6 +206,8 @@ class LiveView:
                 _points(scene, "/targets/arm", s.arm_targets, GREEN, 0.03)
                 _points(scene, "/targets/base", [(x_, y_, 0.01) for x_, y_ in s.base_targets],
                         RED, 0.06)
+            for layer in self.layers:
+                layer.update(scene, (*s.world.base_position[:2], 2 * math.atan2(z, w)))
         self.follow.moved(s.world.base_position)
         if self.frames % PANEL_EVERY == 1:
             text = panel_text(s.arm, s.base)

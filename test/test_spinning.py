@@ -201,7 +201,9 @@ def test_nodes_of_one_name_are_one_line_and_exit_status_2(tmp_path):
     ("acti_bringup", "view_host:=192.0.2.1", "", "is not an address of this machine"),
     # named alone (it listed every view rule with its value: "view_port … (is 8080)")
     ("acti_bringup", "acti_view:view_rate_hz:=0.0", "", "view_rate_hz out of range"),
-    ("acti_bringup", "rate_hz:=250.0", "/robot-1", "Couldn't parse remap rule")])
+    ("acti_bringup", "rate_hz:=250.0", "/robot-1", "Couldn't parse remap rule"),
+    ("vehicle_node", "world:=/no/such/world.yaml", "",
+     "world file /no/such/world.yaml: the file: No such file or directory")])
 def test_a_refused_start_up_setting_is_one_line_and_exit_status_2(tmp_path, module, param,
                                                                   namespace, words):
     """Was: a traceback (and exit status 1) for a value out of range or of the wrong type, or a

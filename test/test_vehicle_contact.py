@@ -8,9 +8,15 @@ from acti_motion.vehicle.core import VehicleState
 from acti_motion.vehicle.alarms import AlarmCode
 from acti_sim.world import WHEEL_JOINTS
 from sim_fixtures import executor, run_until  # noqa: F401
-from vehicle_fixtures import base, position, ready, settle, state, state_msg, steps  # noqa: F401
+from vehicle_fixtures import blind_base, position, ready, settle, state, state_msg, steps  # noqa: F401
 
 BUMPER_FRONT = 321.0          # mm ahead of base_link
+
+
+@pytest.fixture
+def base(blind_base):  # noqa: F811
+    """Without obstacle zones, which would stop it before the wall (test_obstacles.py)."""
+    return blind_base
 
 
 @pytest.fixture

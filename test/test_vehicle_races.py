@@ -12,7 +12,7 @@ from acti_motion.vehicle import cruise
 from acti_motion.vehicle.alarms import AlarmCode, Kind
 from acti_motion.vehicle.core import VehicleConfig, VehicleCore, VehicleState
 from sim_fixtures import executor, run_until  # noqa: F401
-from vehicle_fixtures import base, position, ready, settle, state, state_msg, steps, trace  # noqa: F401
+from vehicle_fixtures import base, blind_base, position, ready, settle, state, state_msg, steps, trace  # noqa: F401
 
 BUMPER_FRONT = 321.0          # mm ahead of base_link
 
@@ -166,7 +166,8 @@ def test_the_battery_fault_does_not_end_when_the_load_drops(base, executor):  # 
 
 # --- a blocked move ends Stuck ------------------------------------------------------------
 @pytest.mark.parametrize("distance", [100.0, 1000.0])
-def test_a_move_into_a_wall_ends_stuck_and_not_completed(base, executor, distance):  # noqa: F811
+def test_a_move_into_a_wall_ends_stuck_and_not_completed(blind_base, executor, distance):  # noqa: F811
+    base = blind_base                                          # no zones to stop it before the wall
     gap = 0.03                                                 # 30 mm ahead of the bumper
     executor.world.add_box((BUMPER_FRONT / 1000.0 + gap + 0.1, 0.0, 0.25), (0.1, 0.6, 0.25))
     ready(base)

@@ -6,12 +6,22 @@ import math
 import pytest
 
 from acti_motion.vehicle.core import VehicleConfig, VehicleCore, VehicleState
+from acti_motion.vehicle.obstacles import ObstacleConfig
 from sim_fixtures import executor, run_until  # noqa: F401
 
 
 @pytest.fixture
 def base(executor):  # noqa: F811
     return VehicleCore(executor, VehicleConfig(queue_size=4))
+
+
+# no obstacle zones: the base drives into what is ahead (the contact sensor, a blockage)
+BLIND = ObstacleConfig(caution_distance=0.0, stop_distance=0.0)
+
+
+@pytest.fixture
+def blind_base(executor):  # noqa: F811
+    return VehicleCore(executor, VehicleConfig(queue_size=4), BLIND)
 
 
 def state(base) -> int:

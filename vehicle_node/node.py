@@ -8,7 +8,11 @@ Topics (REP 103: m, rad):
   ~/state (acti_msgs/VehicleStatus)   state code and string of table 7 and what makes it, 10 Hz
   /diagnostics (DiagnosticArray)      battery and alarms, 1 Hz
   cmd_vel (geometry_msgs/Twist, in)   a move_jog per message (stops after the jog timeout),
-                                      clamped to the unit's limits (said once in the log)
+                                      clamped to the unit's limits (said once in the log);
+                                      TwistStamped with cmd_vel_stamped
+  scan (sensor_msgs/LaserScan)        the laser scanner, frame base_scan (acti_bringup.surroundings)
+  map (nav_msgs/OccupancyGrid)        the world file's obstacles, latched
+  initialpose (in)                    where the base is in the map (acti_bringup.surroundings.localization)
   joy (sensor_msgs/Joy, in)           drives the base while set_joystick(true)
 """
 from __future__ import annotations
@@ -19,7 +23,7 @@ from typing import Any
 
 from acti_msgs.msg import VehicleStatus
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from geometry_msgs.msg import Twist
+from geometry_msgs.msg import Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from sensor_msgs.msg import Joy
@@ -29,11 +33,15 @@ from acti_bringup.serving.adapter import Plane, serve_operations
 from acti_bringup.serving.parameters import declare_config
 from acti_bringup.serving.spinning import warn_of_namesakes
 from acti_bringup.simulation import Simulation
+from acti_bringup.surroundings.localization import Localization, LocalizationConfig
+from acti_bringup.surroundings.scan import ScanPublisher
+from acti_bringup.surroundings.world_map import MapPublisher
 from acti_bringup.visual.transforms import planar_transform, tf_publisher
 from acti_motion.vehicle.paths import Odometry as WheelOdometry, Pose2D
 from acti_motion.replies import Reply
 from acti_motion.vehicle.core import VehicleConfig, VehicleCore
 from acti_motion.vehicle.alarms import AlarmType
+from acti_motion.vehicle.obstacles import ObstacleConfig
 from acti_sim.world import World
 from vehicle_node.actions import WaitConfig, WaitMotionServer
 from vehicle_node.operations import OPERATIONS
@@ -50,6 +58,7 @@ PLANAR_VARIANCE = 1e-6
 class FrameConfig:
     position_frame: str = "map"    # frame of the spec's position (get/set_position); position_frame → odom on /tf is what set_position redefined (rename it if a localizer publishes map → odom)
     odom_tf: bool = True           # publish odom → base_link and position_frame → odom on /tf (false when another node, e.g. a filter, publishes them)
+    cmd_vel_stamped: bool = False  # cmd_vel is geometry_msgs/TwistStamped (Nav2's enable_stamped_cmd_vel) instead of Twist (Jazzy's default)
 
 
 def write_success(response: Any, reply: Reply) -> None:
@@ -102,7 +111,8 @@ class VehicleNode(Node):
     def __init__(self, simulation: Simulation | None = None) -> None:
         super().__init__("vehicle_node")
         self.simulation = simulation or Simulation(self)
-        self.core = VehicleCore(self.simulation.executor, declare_config(self, VehicleConfig))
+        self.core = VehicleCore(self.simulation.executor, declare_config(self, VehicleConfig),
+                                declare_config(self, ObstacleConfig))
         self.motion, self.goals = Plane(self, "motion"), Plane(self, "goals")
         serve_operations(self, self.motion, self.core, OPERATIONS, write_success)
         self.wait_motion = WaitMotionServer(self.goals, self.core, declare_config(self, WaitConfig))
@@ -118,7 +128,17 @@ class VehicleNode(Node):
         self._cmd_vel_clamped = False
         self._joy_axes_missing = False
         # commands that move the base arrive on the motion plane, like the move services
-        self.motion.create_subscription(Twist, "cmd_vel", self._on_cmd_vel, 10)
+        if self.frames.cmd_vel_stamped:
+            self.motion.create_subscription(TwistStamped, "cmd_vel",
+                                            lambda msg: self._on_cmd_vel(msg.twist), 10)
+        else:
+            self.motion.create_subscription(Twist, "cmd_vel", self._on_cmd_vel, 10)
+        self.scan = ScanPublisher(self, self.simulation)
+        self.world_map = MapPublisher(self, self.simulation, self.frames.position_frame)
+        self.core.know_map(self.world_map.grid)
+        self.localization = Localization(self, declare_config(self, LocalizationConfig),
+                                         self.frames.position_frame, self.core.set_position,
+                                         self.motion)
         self.motion.create_subscription(Joy, "joy", self._on_joy, 10)
         sim = self.simulation
         odometry_out = [p for p in (self._odom, self._truth, self._tf) if p is not None]
@@ -167,7 +187,8 @@ class VehicleNode(Node):
         if self._tf is not None:
             self._tf.publish(TFMessage(transforms=[
                 planar_transform(stamp, "odom", "base_link", pose, world.wheel_radius),
-                planar_transform(stamp, self.frames.position_frame, "odom", frame)]))
+                planar_transform(stamp, self.frames.position_frame, "odom",
+                                 self.localization.map_to_odom(world, pose, frame))]))
         v, w = world.base_twist()
         self._truth.publish(odometry_message(stamp, "world", *world.base_link_pose(), v, w))
 

@@ -12,8 +12,10 @@ from acti_motion.config_fields import RATE_RANGE_HZ, ranged
 from acti_motion.arm.core import ArmCore
 from acti_motion.vehicle.core import VehicleCore
 from acti_sim.world import URDF_PATH
+from acti_bringup.surroundings.scan import ScanPublisher
 from acti_view.live import LiveView
 from acti_view.program import ProgramSource
+from acti_view.surroundings import SurroundingsLayer
 from acti_view.sample import Reader, WorldSampler
 
 
@@ -33,7 +35,8 @@ class ViewNode(Node):
     """`acti_view`: serves the view of the arm and base of `simulation` (when enabled)."""
 
     def __init__(self, simulation: Simulation, arm: ArmCore, vehicle: VehicleCore,
-                 program: ProgramSource | None = None) -> None:
+                 program: ProgramSource | None = None,
+                 scan: ScanPublisher | None = None) -> None:
         super().__init__("acti_view")
         self.config = c = declare_config(self, ViewConfig)
         self.view: LiveView | None = None
@@ -42,9 +45,15 @@ class ViewNode(Node):
             return
         every = max(1, round(simulation.config.rate_hz / c.view_rate_hz))
         reader = Reader(WorldSampler(simulation.executor, every), arm, vehicle)
+        scanner = scan.scanner if scan is not None else None
+        surroundings = SurroundingsLayer(
+            simulation.surroundings, scanner, lambda: scan.latest if scan is not None else None,
+            vehicle, simulation.world.footprint,
+            on_watch=lambda watched: setattr(scan, "watched", watched) if scan is not None else None)
         self.view = LiveView(reader, {"arm": arm, "base": vehicle}, URDF_PATH, c.view_host,
                              c.view_port, c.view_rate_hz, c.view_trail_points,
-                             log=self.get_logger().info, program=program)
+                             log=self.get_logger().info, program=program,
+                             layers=(surroundings,))
         self.view.start()           # its URL: in the job's READY line, once the job serves
 
     def destroy_node(self) -> None:

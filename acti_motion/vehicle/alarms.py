@@ -34,6 +34,7 @@ class AlarmCode(IntEnum):
     NOT_HOLONOMIC = 105         # impossible for a differential drive (y velocity, centre off the axle)
     BATTERY_LOW = 110           # battery below the low-voltage warning level
     STUCK = 120                 # the base could not follow its path and stopped
+    OBSTACLE = 121              # an obstacle in the stop zone: the base stopped (Stuck)
     BATTERY_EMPTY = 201         # battery below the cut-off voltage: power and servo off
     CONTACT = 301               # the contact sensor touched something: Locked until unlock
 

@@ -44,6 +44,8 @@ class Control:
             return VehicleState.BUSY if self.device.moving and self.device.rate > 0.0 else VehicleState.PAUSED
         if self.stuck:
             return VehicleState.STUCK
+        if self.avoiding:             # stopping for a detour, or on it (acti_motion.vehicle.obstacles)
+            return VehicleState.AVOID
         if self.device.busy:
             return VehicleState.BUSY
         if self._latest_warning() is not None:

@@ -22,6 +22,7 @@ from acti_motion.vehicle.alarms import Alarms, Kind
 from acti_motion.vehicle.config import VehicleConfig, check_config
 from acti_motion.vehicle.control import FIRMWARE_VERSION, IF_VERSION, WHEEL_AXES, Control
 from acti_motion.vehicle.cruise import plan_curve
+from acti_motion.vehicle.obstacles import ObstacleConfig, Obstacles
 from acti_motion.vehicle.paths import Odometry, Pose2D
 from acti_motion.vehicle.planning import (LOOKAHEAD_GROWTH, LOOKAHEAD_STEPS, PAUSED, PAUSED_DRIVE,
                                           Planning)
@@ -35,7 +36,7 @@ __all__ = ["FIRMWARE_VERSION", "IF_VERSION", "LOOKAHEAD_GROWTH", "LOOKAHEAD_STEP
            "PAUSED_DRIVE", "WHEEL_AXES", "VehicleConfig", "VehicleCore", "VehicleState"]
 
 
-class VehicleCore(Control, Planning, Sensing):
+class VehicleCore(Control, Planning, Sensing, Obstacles):
     """Power, servo, state, alarms, I/O, battery, odometry and the motion queue of the base.
 
     Two locks: `lock` guards the state for a moment (control operations, checks, commits);
@@ -45,7 +46,8 @@ class VehicleCore(Control, Planning, Sensing):
     path is `Control`, the planning path `Planning`, the simulation thread's step `Sensing`.
     """
 
-    def __init__(self, executor: MotionExecutor, config: VehicleConfig | None = None) -> None:
+    def __init__(self, executor: MotionExecutor, config: VehicleConfig | None = None,
+                 obstacles: ObstacleConfig | None = None) -> None:
         self.config = c = config or VehicleConfig()
         check_config(c)
         world = executor.world
@@ -87,6 +89,7 @@ class VehicleCore(Control, Planning, Sensing):
         self.joystick = False
         self._stick = (0.0, 0.0)             # the last Joy sample's deflections that drove the base
         self._dt = executor.dt
+        self._init_obstacles(obstacles or ObstacleConfig(), world)
         self._warm_up()
         executor.before_step(self._sense)
 
@@ -95,6 +98,8 @@ class VehicleCore(Control, Planning, Sensing):
         plan_curve(Pose2D(0.0, 0.0, 0.0), [(0.5, 0.2), (1.0, 0.0)], self._limits())
 
     def _accepted_motion(self) -> None:
-        """Both paths: an accepted motion, and stop, end Stuck."""
+        """Both paths: an accepted motion, and stop, end Stuck (and a pending or running
+        detour's Avoid: the detour itself sets it again once queued)."""
         self.stuck = False
+        self.avoiding = False
         self.alarms.clear(Kind.STUCK)

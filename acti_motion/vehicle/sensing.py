@@ -44,6 +44,7 @@ class Sensing:
                                        "contact sensor: the bumper touched something", Kind.CONTACT)
                     self._halt("a contact (the base is Locked)")
         self._watch_tracking(world.time)
+        self._watch_obstacles(world)
         self._watch_deadman()
 
     def _contact_trips(self) -> bool:
