@@ -102,7 +102,7 @@ class Simulation:
         self.publish_at(c.joint_state_rate_hz, self._publish_joint_states, self._joints)
         self.graph = RobotGraph(node, self.world.urdf_path, c.joint_state_rate_hz, self.now,
                                 self.publish_at)
-        self.camera = SimCamera(node, self.executor, self.now)
+        self.camera = SimCamera(node, self.executor, self.now, self.surroundings)
 
     def publish_at(self, rate_hz: float, publish: Callable[[World], None],
                    *publishers: Publisher, wanted: Callable[[], bool] = lambda: False) -> None:

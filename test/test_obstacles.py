@@ -150,3 +150,13 @@ def test_avoid_without_a_way_around_ends_stuck(executor):  # noqa: F811
     assert VehicleState.AVOID in seen
     alarm = [a for a in base.get_active_alarm(5).values["active_alarms"] if a[0] == AlarmCode.OBSTACLE]
     assert alarm and "no way around" in alarm[0][2]
+
+
+def test_avoid_backs_away_from_an_obstacle_met_in_reverse(executor):  # noqa: F811
+    base = avoiding_base(executor, [(-2.2, 0.0, 0.2, 0.5)])
+    assert base.move_forward(-3500.0).ok
+    seen = run_watching_contact(
+        executor, base, lambda: state(base) == VehicleState.READY and not base.device.busy, 90.0)
+    assert VehicleState.AVOID in seen and VehicleState.STUCK not in seen
+    x, y, _ = position(base)
+    assert (x, y) == pytest.approx((-3500.0, 0.0), abs=30.0)

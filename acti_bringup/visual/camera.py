@@ -30,6 +30,7 @@ from acti_motion.executor import MotionExecutor
 from acti_motion.arm.poses import quaternion_xyzw
 from acti_motion.config_fields import ranged
 from acti_motion.link_poses import LinkTransform
+from acti_sim.surroundings.worldfile import WorldSpec, build_world
 from acti_sim.world import World
 
 PARENT_FRAME = "odom"
@@ -87,13 +88,15 @@ def camera_info(width: int, height: int, fov_deg: float) -> CameraInfo:
     return info
 
 
-def render_frames(requests: Any, frames: Any, urdf_path: str, config: CameraConfig) -> None:
+def render_frames(requests: Any, frames: Any, urdf_path: str, config: CameraConfig,
+                  surroundings: WorldSpec = WorldSpec()) -> None:
     """The render process: pose a copy of the world as asked, send back the RGB bytes; ends
     when the simulation's end of the pipe closes. SIGINT is the host's to handle. It runs at
     ordinary niceness (0), not the control loop's raised one: its frames may wait, the robot not."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     os.setpriority(os.PRIO_PROCESS, 0, 0)
     world = World(urdf_path=urdf_path)
+    build_world(world, surroundings)          # the world file's obstacles in the picture too
     c = config
     try:
         while True:
@@ -109,7 +112,8 @@ def render_frames(requests: Any, frames: Any, urdf_path: str, config: CameraConf
 class SimCamera:
     """Publishes the work-cell camera when `camera_rate_hz` > 0."""
 
-    def __init__(self, node: Node, executor: MotionExecutor, now: Callable[[], Any]) -> None:
+    def __init__(self, node: Node, executor: MotionExecutor, now: Callable[[], Any],
+                 surroundings: WorldSpec = WorldSpec()) -> None:
         self.config = c = declare_config(node, CameraConfig)
         check_camera(c)
         if c.camera_rate_hz == 0:
@@ -125,7 +129,7 @@ class SimCamera:
         requests, self._requests = spawn.Pipe(duplex=False)
         self._frames, frames = spawn.Pipe(duplex=False)
         spawn.Process(target=render_frames, name="acti-camera", daemon=True,
-                      args=(requests, frames, executor.world.urdf_path, c)).start()
+                      args=(requests, frames, executor.world.urdf_path, c, surroundings)).start()
         requests.close()
         frames.close()
         self._stamp: Any = None                 # of the frame being rendered; None: idle

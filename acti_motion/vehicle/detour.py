@@ -28,10 +28,11 @@ def clearance(grid: Grid) -> np.ndarray:
     return distance_transform_edt(free) * grid.resolution - grid.resolution / 2
 
 
-def plan_detour(grid: Grid, start: Pose2D, goal: Pose2D,
-                radius: float) -> list[tuple[float, float]] | None:
+def plan_detour(grid: Grid, start: Pose2D, goal: Pose2D, radius: float,
+                reversing: bool = False) -> list[tuple[float, float]] | None:
     """Waypoints (m, map frame) from `start` to `goal` for a base of circumscribed `radius`;
-    the first is where the backing up ends."""
+    the first is where the backing up (away from the obstacle: forwards when the base was
+    `reversing` into it) ends."""
     grid = grid.covering([(start.x, start.y), (goal.x, goal.y)], MAX_BACKUP_M + 2 * radius)
     room = clearance(grid)
 
@@ -39,7 +40,7 @@ def plan_detour(grid: Grid, start: Pose2D, goal: Pose2D,
         r, c = grid.cell_of(x, y)
         return 0 <= r < room.shape[0] and 0 <= c < room.shape[1] and room[r, c] >= radius
 
-    back = _backed_up(start, clear, grid.resolution)
+    back = _backed_up(start, clear, grid.resolution * (1.0 if reversing else -1.0))
     if back is None or not clear(goal.x, goal.y):
         return None
     cells = _a_star(room >= radius, grid.cell_of(back.x, back.y), grid.cell_of(goal.x, goal.y))
@@ -52,9 +53,10 @@ def plan_detour(grid: Grid, start: Pose2D, goal: Pose2D,
 
 
 def _backed_up(start: Pose2D, clear, step: float) -> Pose2D | None:
-    """The nearest pose straight behind `start` where the base may turn."""
-    for k in range(int(MAX_BACKUP_M / step) + 1):
-        here = start.forward(-k * step)
+    """The nearest pose straight along `start`'s heading by steps of `step` (negative: behind
+    it) where the base may turn."""
+    for k in range(int(MAX_BACKUP_M / abs(step)) + 1):
+        here = start.forward(k * step)
         if clear(here.x, here.y):
             return here
     return None

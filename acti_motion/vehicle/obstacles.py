@@ -168,7 +168,7 @@ class Obstacles:
         sight = watch.look(world, v_ref > 0, max(caution, stop))
         self.sighting = sight
         if sight is not None and sight.gap <= stop:
-            self._stop_for(sight)
+            self._stop_for(sight, reversing=v_ref < 0)
         elif sight is not None and sight.gap <= caution:
             c = self.obstacle_config
             limit = min(c.caution_velocity, self.velocity[0]) / 1000.0
@@ -188,7 +188,7 @@ class Obstacles:
                 cur.motion, "reference_twist") else 0.0
             self.device.cap_rate(1.0, max(v, MOVING) / a)
 
-    def _stop_for(self, sight: Sighting) -> None:
+    def _stop_for(self, sight: Sighting, reversing: bool) -> None:
         """Stop at the acceleration limit; then a detour (Avoid) where one is allowed, else
         Stuck with alarm 121 giving the obstacle's range and bearing."""
         cur = self.device.current
@@ -202,7 +202,7 @@ class Obstacles:
                 goal = cur.motion.at(cur.motion.duration)
                 self.avoiding, self._detour_id = True, None
                 self._stop("an obstacle in the stop zone: a detour follows (Avoid)")
-                threading.Thread(target=self._detour, args=(goal, where), daemon=True,
+                threading.Thread(target=self._detour, args=(goal, where, reversing), daemon=True,
                                  name="acti-detour").start()
                 return
             self._go_stuck(f"{where}: stopped")
@@ -215,7 +215,7 @@ class Obstacles:
                            f"{what}; clear_alarm, or a motion away from it, ends Stuck", Kind.STUCK)
         self._stop("an obstacle in the stop zone (the base is Stuck)")
 
-    def _detour(self, goal: Pose2D, where: str) -> None:
+    def _detour(self, goal: Pose2D, where: str, reversing: bool) -> None:
         """Off the simulation thread: once the base is at rest, plan the detour to `goal`
         (odometry frame) and queue it; none: Stuck."""
         device, deadline = self.device, time.monotonic() + REST_WAIT_S
@@ -229,10 +229,13 @@ class Obstacles:
             odom_in_world = truth.compose(rest.inverse())
             start = odom_in_world.compose(rest)
             target = odom_in_world.compose(goal)
-            points = plan_detour(self._known_map, start, target, self._radius + DETOUR_MARGIN)
+            points = plan_detour(self._known_map, start, target, self._radius + DETOUR_MARGIN,
+                                 reversing)
             if points is None:
                 with self.lock:
-                    self._go_stuck(f"{where}: stopped, and the map has no way around it")
+                    self._go_stuck(f"{where}: stopped, and the map has no way around it from "
+                                   f"({start.x:.2f}, {start.y:.2f}) to ({target.x:.2f}, "
+                                   f"{target.y:.2f}) m")
                 return
             world_to_odom = odom_in_world.inverse()
             legs = [world_to_odom.compose(Pose2D(x, y, 0.0)) for x, y in points]
