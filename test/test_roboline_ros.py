@@ -154,6 +154,8 @@ def test_breakpoints_step_continue_and_variables(ros, programs):
         return answer.state == "at breakpoint" and answer.line == line
     assert wait_until(lambda: held_at(5), 60.0)
     assert call(ros, "get_state", srv.GetState).state & 0x02 == 0      # its motion has ended
+    assert ros.spin_until(lambda: any(f.state == "at breakpoint" and f.line == 5
+                                      and list(f.breakpoints) == [5] for f in feedback), 30.0)
     value = variable(ros, "n")
     assert value.success and (value.type, value.value) == ("int", "I4:1")
     missing = variable(ros, "m")
@@ -167,8 +169,6 @@ def test_breakpoints_step_continue_and_variables(ros, programs):
     assert debug(D.CONTINUE).success
     assert wait_until(lambda: held_at(7), 60.0)
     assert variable(ros, "N").value == "I4:4"
-    assert any(f.state == "at breakpoint" and f.line == 5 and 5 in f.breakpoints
-               for f in feedback)
     debug(D.CLEAR)
     assert list(debug(D.CONTINUE).breakpoints) == []
     status, result = programs.result(handle)
