@@ -37,6 +37,42 @@ def running(module: str, *params: str, args: tuple[str, ...] = ()) -> Iterator[N
             node.stop()
 
 
+@contextmanager
+def view_page(ros: RosClient, width: int, height: int, *params: str) -> Iterator[tuple]:
+    """(job, browser): a main job (view on, any free port, `params`) with its live view open
+    in a headless browser, the robot drawn and the page's notices dismissed."""
+    import re
+
+    from acti_bringup.harness import wait_until
+    from acti_bringup.visual.browser import dismiss_notices, open_browser, robot_pixels, screenshot
+    with running("acti_bringup", "view_port:=0", *params) as job:
+        assert wait_until(lambda: "live view: " in job.log(), 60.0), job.log()
+        url = re.search(r"live view: (\S+)", job.log()).group(1)
+        browser = open_browser(width, height)
+        try:
+            browser.get(url)
+            assert ros.spin_until(lambda: robot_pixels(screenshot(browser)).sum() > 300, 120.0), \
+                "the page did not draw the robot"
+            dismiss_notices(browser)
+            yield job, browser
+        finally:
+            browser.quit()
+
+
+def ok(reply) -> None:
+    """An answer of either port that says OK (arm: return_id 0; base: success)."""
+    status = getattr(reply, "return_id", None)
+    assert (status.id == 0) if status is not None else reply.success, reply
+
+
+def save_page(browser, out: str) -> None:
+    """The page as the browser shows it, to a PNG."""
+    import matplotlib.image as mpimg
+
+    from acti_bringup.visual.browser import screenshot
+    mpimg.imsave(out, screenshot(browser))
+
+
 def bare_call(ros: RosClient) -> Callable[[], object]:
     from std_srvs.srv import Trigger
     return lambda: ros.call(Trigger, BARE)

@@ -6,15 +6,11 @@ around the current one (▶) and its breakpoints (●).
 """
 from __future__ import annotations
 
-import os
-import re
 import sys
 from pathlib import Path
 
-from common import Actions, RosClient, running
+from common import Actions, RosClient, save_page, view_page
 
-from acti_bringup.harness import wait_until
-from acti_bringup.visual.browser import dismiss_notices, open_browser, robot_pixels, screenshot
 from acti_msgs import srv
 from acti_msgs.action import RunProgram
 
@@ -27,34 +23,23 @@ BREAK_AT = 22            # the WAIT after MOVE L, target: held there the second 
 def main() -> None:
     out = sys.argv[1] if len(sys.argv) > 1 else str(ROOT / "docs" / "program_view.png")
     ros = RosClient()
-    with running("acti_bringup", "view_port:=0", "real_time_factor:=4.0") as job:
-        assert wait_until(lambda: "live view: " in job.log(), 60.0), job.log()
-        url = re.search(r"live view: (\S+)", job.log()).group(1)
-        browser = open_browser(1100, 820)
-        try:
-            browser.get(url)
-            assert ros.spin_until(lambda: robot_pixels(screenshot(browser)).sum() > 300, 120.0), \
-                "the page did not draw the robot"
-            dismiss_notices(browser)
-            assert ros.call(srv.ServoON, ARM + "servo_on").return_id.id == 0
-            programs = Actions(ros, RunProgram, ARM + "run_program")
-            handle = programs.send(source=EXAMPLE.read_text(), source_name=EXAMPLE.name,
-                                   points=EXAMPLE.with_suffix(".pts").read_text(),
-                                   breakpoints=[BREAK_AT])
-            debug = lambda: ros.call(srv.ProgramDebug, ARM + "program_debug",  # noqa: E731
-                                     command=srv.ProgramDebug.Request.SET, lines=[])
-            for _ in range(2):             # the second stop: a placed part's trail in view
-                assert ros.spin_until(lambda: debug().state == "at breakpoint", 120.0)
-                if _ == 0:
-                    ros.call(srv.ProgramDebug, ARM + "program_debug",
-                             command=srv.ProgramDebug.Request.CONTINUE)
-                    assert ros.spin_until(lambda: debug().state != "at breakpoint", 30.0)
-            ros.spin_until(lambda: False, 2.0)          # the panel refreshes
-            import matplotlib.image as mpimg
-            mpimg.imsave(out, screenshot(browser))
-            programs.cancel(handle)
-        finally:
-            browser.quit()
+    with view_page(ros, 1100, 820, "real_time_factor:=4.0") as (_job, browser):
+        assert ros.call(srv.ServoON, ARM + "servo_on").return_id.id == 0
+        programs = Actions(ros, RunProgram, ARM + "run_program")
+        handle = programs.send(source=EXAMPLE.read_text(), source_name=EXAMPLE.name,
+                               points=EXAMPLE.with_suffix(".pts").read_text(),
+                               breakpoints=[BREAK_AT])
+        debug = lambda: ros.call(srv.ProgramDebug, ARM + "program_debug",  # noqa: E731
+                                 command=srv.ProgramDebug.Request.SET, lines=[])
+        for _ in range(2):             # the second stop: a placed part's trail in view
+            assert ros.spin_until(lambda: debug().state == "at breakpoint", 120.0)
+            if _ == 0:
+                ros.call(srv.ProgramDebug, ARM + "program_debug",
+                         command=srv.ProgramDebug.Request.CONTINUE)
+                assert ros.spin_until(lambda: debug().state != "at breakpoint", 30.0)
+        ros.spin_until(lambda: False, 2.0)          # the panel refreshes
+        save_page(browser, out)
+        programs.cancel(handle)
     ros.close()
     print(f"wrote {out}")
 

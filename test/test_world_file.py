@@ -131,6 +131,14 @@ def test_a_sweep_is_spread_over_the_steps_of_its_period(room_world):
         room_world.step()
     assert calls == pytest.approx(0.1 / room_world.time_step, abs=2)
     assert np.allclose(scan.ranges, scanner.scan_now(room_world).ranges, atol=1e-3)
+    starts = [scan.start_time]                     # every 3rd step: sweeps a period apart
+    while len(starts) < 4:
+        for _ in range(3):
+            room_world.step()
+        done = scanner.advance(room_world)
+        if done is not None:
+            starts.append(done.start_time)
+    assert np.diff(starts) == pytest.approx([0.1] * 3, abs=1e-9)
 
 
 def test_noise_has_its_spread():

@@ -71,7 +71,7 @@ class LaserScanner:
         self._directions = np.stack([np.cos(angles), np.sin(angles), np.zeros_like(angles)], 1)
         self._ranges = np.full(geometry.beams, math.inf)
         self._next = 0                 # the next beam to cast
-        self._start = 0.0              # the sweep's start time
+        self._start: float | None = None   # the sweep's start time (the next one's, between)
         self._rng = np.random.default_rng(seed)
 
     @property
@@ -79,17 +79,21 @@ class LaserScanner:
         return self.period / self.geometry.beams
 
     def advance(self, world: World) -> Scan | None:
-        """Cast the beams due by `world.time`; the finished scan when the sweep ends."""
-        if self._next == 0:
-            self._start = world.time
+        """Cast the beams due by `world.time`; the finished scan when the sweep ends. Sweeps
+        start a period apart (or now, after a pause of more than a period)."""
+        if self._start is None or world.time - self._start > 2 * self.period:
+            self._start, self._next = world.time, 0
+        if world.time < self._start - 1e-9:
+            return None                                 # the next sweep is not due yet
         due = math.floor((world.time - self._start) / self.time_increment + 1e-9) + 1
         end = min(self.geometry.beams, max(due, self._next + 1))
         self._cast(world, self._next, end)
         self._next = end
         if end < self.geometry.beams:
             return None
-        self._next = 0
-        return Scan(self._start, self._ranges.copy(), self._pose(world))
+        scan = Scan(self._start, self._ranges.copy(), self._pose(world))
+        self._next, self._start = 0, self._start + self.period
+        return scan
 
     def scan_now(self, world: World) -> Scan:
         """A whole sweep at once (tests, one-off views)."""
