@@ -179,3 +179,11 @@ def test_what_is_not_a_recording_is_refused_with_one_line(tmp_path, content):
         refused = run("acti_bringup.replay", *args, timeout=60)
         assert refused.returncode == 2 and refused.stdout == "", refused
         assert refused.stderr.count("\n") == 1 and "Traceback" not in refused.stderr
+
+
+def test_an_unknown_introspection_setting_stops_the_job_with_one_line(tmp_path):
+    refused = run("acti_bringup", "--ros-args", "-p", "service_introspection:=everything",
+                  "-p", "view_enabled:=false", timeout=120)
+    out = refused.stdout + refused.stderr
+    assert refused.returncode == 2 and "Traceback" not in out, out
+    assert "service_introspection is 'everything': use one of disabled, metadata, contents" in out

@@ -22,21 +22,22 @@ from type_description_interfaces.srv import GetTypeDescription
 
 from acti_bringup.serving.unlocked import GUID_BYTES, header_address
 
-STATES = {"off": ServiceIntrospectionState.OFF, "metadata": ServiceIntrospectionState.METADATA,
+# "disabled", not "off": YAML (the parameters' syntax) reads off as false
+STATES = {"disabled": ServiceIntrospectionState.OFF, "metadata": ServiceIntrospectionState.METADATA,
           "contents": ServiceIntrospectionState.CONTENTS}
 EVENT_QOS = qos_profile_services_default        # rcl's default for introspection publishers
 EVENT_TOPIC = "_service_event"
 
 
 def introspect(nodes: Iterable[Node], state: str) -> list[str]:
-    """Introspection `state` (off | metadata | contents) on every service and action server
+    """Introspection `state` (disabled | metadata | contents) on every service and action server
     of `nodes`, but the nodes' `get_type_description` (rcl's own service: rclpy refuses to
     configure it, and crashes on the second refusal). Call it after the nodes' action servers got their final handles (the job's
     outbox wraps them: `acti_bringup.serving.spinning.Planes.add`). The event topics."""
     if state not in STATES:
         raise ValueError(f"service_introspection {state!r}: use one of {', '.join(STATES)}")
     topics: list[str] = []
-    if state == "off":
+    if state == "disabled":
         return topics
     for node in nodes:
         for service in node.services:

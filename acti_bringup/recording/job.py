@@ -23,7 +23,7 @@ RECORDER_READY_S = 30.0
 @dataclass
 class RecordingConfig:
     # requests and answers of every service and action of the job on <service>/_service_event
-    # topics, which a recording keeps: contents, metadata (who called when) or off
+    # topics, which a recording keeps: contents, metadata (who called when) or disabled
     service_introspection: str = "contents"
     # record everything (every topic, service call and action) from start-up into this MCAP
     # file, closed when the job ends (python -m acti_bringup.record); "": no recording
