@@ -105,9 +105,13 @@ def nestin(vm: VM, proc: Process) -> None:
 
 
 def nestout(vm: VM, proc: Process) -> None:
-    """NESTOUT: drop the innermost local space; at the outermost level it does nothing."""
-    if len(proc.scopes) > 1:
-        proc.scopes.pop()
+    """NESTOUT: drop the innermost local space. At the outermost level there is none to leave
+    (EF5E leaves NESTOUT without a saved level unspecified): an exception, and the program's
+    globals stay as they were, so a handler or the report still sees them."""
+    if len(proc.scopes) == 1:
+        raise fail(K.COMPUTER_ERROR, "NESTOUT at the outermost level: no nesting structure "
+                   "(NESTIN) to leave")
+    proc.scopes.pop()
 
 
 def npush(vm: VM, proc: Process) -> None:

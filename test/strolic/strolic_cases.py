@@ -263,9 +263,11 @@ CASES: dict[str, list[tuple[str, list[str] | K]]] = {
                ("#x 1 STORE 1 NESTIN VAR #x DCL #x 2 STORE 1 NESTIN x NESTOUT x", ["1", "2"]),
                ("-1 NESTIN", UNDEF),
                (" ".join(["1 NESTIN"] * 40), K.STACK_OVERFLOW)],
-    "NESTOUT": [("1 NESTIN VAR #%2000 DCL NESTOUT #%2000 PUSH", UNDEF), ("NESTOUT 1", ["1"]),
-                # at the outermost level it does nothing: the globals stay, twice over
-                ("#x 1 STORE NESTOUT NESTOUT x", ["1"])],
+    "NESTOUT": [("1 NESTIN VAR #%2000 DCL NESTOUT #%2000 PUSH", UNDEF),
+                ("#x 1 STORE 1 NESTIN VAR #x DCL #x 2 STORE NESTOUT x", ["1"]),
+                ("NESTOUT 1", K.COMPUTER_ERROR),
+                # at the outermost level it is an exception, and the globals stay
+                ("1 NESTIN NESTOUT #x 1 STORE NESTOUT", K.COMPUTER_ERROR)],
     "NPUSH": [("#x 1 STORE 1 NESTIN VAR #x DCL #x 2 STORE #x 0 NPUSH #x 1 NPUSH", ["1", "2"]),
               ("#x 5 NPUSH", UNDEF), ("1 NESTIN #x 1 NPUSH", UNDEF)],
     "NPOP": [("#x 1 STORE 1 NESTIN VAR #x DCL 9 #x 0 NPOP NESTOUT x", ["9"]),

@@ -7,7 +7,7 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 
 from conftest import PRELUDE, ClockHost, RecordingHost, error_of, execute, stack_of
 from strolic.codec import encode
-from strolic.codes import Num, I2
+from strolic.codes import Num, I1, I2
 from strolic.errors import ExceptionKind as K, StrolicError
 from strolic.text import assemble
 from strolic import vm as vm_module
@@ -365,3 +365,14 @@ def test_an_exception_in_a_function_made_at_run_time_is_located_where_it_was_cal
         VM(RecordingHost()).run(program_bytes)
     offset = caught.value.offset
     assert program_bytes[offset:offset + 2] == bytes.fromhex("1003"), caught.value.report()
+
+
+def test_nestout_at_the_outermost_level_is_an_exception_that_keeps_the_globals() -> None:
+    """EF5E leaves NESTOUT without a saved level open: here an exception, and the program's
+    global space (where x was stored) is not the one dropped."""
+    vm = VM()
+    with pytest.raises(StrolicError) as caught:
+        vm.run(assemble(PRELUDE + "#x 5 STORE NESTOUT"))
+    assert caught.value.kind is K.COMPUTER_ERROR and "outermost" in str(caught.value)
+    assert vm.main.scopes == [vm.globals]
+    assert vm.globals.table[0x1000][-1].value() == Num(I1, 5)
