@@ -128,6 +128,7 @@ class Obstacles:
         self.avoiding = False                     # state Avoid: stopping for a detour, or on it
         self._detour_id: int | None = None
         self._known_map: Grid | None = None
+        self._rest_truth = Pose2D(0.0, 0.0, 0.0)  # the true pose while a detour waits (world)
 
     @property
     def obstacle_watched(self) -> bool:
@@ -153,6 +154,8 @@ class Obstacles:
             return
         if self.avoiding and self._detour_id is not None and device.retired_id >= self._detour_id:
             self.avoiding, self._detour_id = False, None          # the detour is over
+        if self.avoiding and self._detour_id is None:
+            self._rest_truth = Pose2D(*world.base_pose())        # for the detour's planning
         if (cur is None or device.stopping or isinstance(cur.motion, BrakeMotion)
                 or not hasattr(cur.motion, "reference_twist")):
             self._lift_cap()
@@ -221,12 +224,15 @@ class Obstacles:
         device, deadline = self.device, time.monotonic() + REST_WAIT_S
         while device.busy and self.avoiding and time.monotonic() < deadline:
             time.sleep(0.01)
+        at_rest = self._world.time
+        while self._world.time <= at_rest + self._dt and self.avoiding \
+                and time.monotonic() < deadline:
+            time.sleep(0.005)             # a step at rest records the true pose (`_rest_truth`)
         with self.planning_operation():
             if not self.avoiding or device.busy:
                 return                      # a stop or another command came meanwhile
             rest = device.hold
-            truth = Pose2D(*self._world.base_pose())
-            odom_in_world = truth.compose(rest.inverse())
+            odom_in_world = self._rest_truth.compose(rest.inverse())
             start = odom_in_world.compose(rest)
             target = odom_in_world.compose(goal)
             points = plan_detour(self._known_map, start, target, self._radius + DETOUR_MARGIN,
