@@ -54,7 +54,8 @@ class ViewNode(Node):
                              c.view_port, c.view_rate_hz, c.view_trail_points,
                              log=self.get_logger().info, program=program,
                              layers=(surroundings,))
-        self.view.start()           # its URL: in the job's READY line, once the job serves
+        self.view.start()
+        self.get_logger().info(f"live view: {self.view.url}")
 
     def destroy_node(self) -> None:
         if self.view is not None:
