@@ -130,8 +130,8 @@ def check_cpu() -> None:
 
 def motion_figures() -> None:
     from acti_motion.arm.poses import orientation_error_deg, pose_to_hg, position_error_mm
-    from acti_motion.arm.trajectories import (CartesianLimits, ConstAccelTiming, LinePath,
-                                              time_optimal)
+    from acti_motion.arm.trajectories import (TOPPRA_GRID, CartesianLimits, ConstAccelTiming,
+                                              LinePath, time_optimal)
 
     world, ex, arm = simulated_arm(ARM_START, 60)
 
@@ -183,7 +183,7 @@ def motion_figures() -> None:
                                  np.radians(arm.max_speed_joint) / arm.min_accel_time_joint)
         line = LinePath(P0, target)
         extents = np.array([line.length, line.angle, 0.0])
-        bound = time_optimal(path.ss, path.qs, extents, limits).duration
+        bound = time_optimal(path.ss, path.qs, extents, limits, TOPPRA_GRID).duration
         deviation = []
 
         def check():
