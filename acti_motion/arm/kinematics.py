@@ -193,15 +193,19 @@ class ArmKinematics:
 
     # --- the arm angle ---------------------------------------------------------------------------
     def reference(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(e1, e2): the arm angle's zero direction and its +90° direction, normal to u = S→W."""
-        for v, floor in ((np.array([0.0, 1.0, 0.0]), LATERAL_CONE),
-                         (np.array([0.0, 0.0, 1.0]), 0.0)):
-            e1 = cross_many(v, u)
-            n = np.linalg.norm(e1)
-            if n > floor:
-                e1 = e1 / n
-                return e1, cross_many(u, e1)
-        raise AssertionError("unreachable: y and z cannot both be parallel to u")
+        """(e1, e2): the arm angle's zero direction and its +90° direction, normal to u = S→W.
+        e1 = ŷ × u where u is clear of ±ŷ, else ẑ × u; in plain floats (one 3-vector: numpy's
+        calls cost more than the arithmetic, twice in every CP plan)."""
+        x, y, z = map(float, u)
+        e = (z, 0.0, -x)                        # ŷ × u
+        n = math.hypot(z, x)
+        if n <= LATERAL_CONE:
+            e, n = (-y, x, 0.0), math.hypot(y, x)   # ẑ × u
+            if n <= 0.0:
+                raise AssertionError("unreachable: y and z cannot both be parallel to u")
+        a, b, c = e[0] / n, e[1] / n, e[2] / n
+        return (np.array([a, b, c]),
+                np.array([y * c - z * b, z * a - x * c, x * b - y * a]))      # u × e1
 
     @staticmethod
     def reference_strength(u: np.ndarray) -> float:
