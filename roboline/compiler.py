@@ -13,11 +13,8 @@ Every code is kept with the line it came from: the source map of `Program`.
 """
 from __future__ import annotations
 
-from __future__ import annotations
-
 from lark import Token, Tree
 
-from strolic.codec import CodeKind, encode_code
 from strolic.codes import I2, I4, R8, Function, Num, Str, Vec, make_number
 
 from .builtins import NUMERIC
@@ -59,12 +56,13 @@ class Compiler(Commands):
         for point in self.points.values():
             self.globals[point.name.upper()] = Symbol(point.name, point.type,
                                                       self.new_key(None))
-        for statement in main:
-            for dim in statement.find_data("dim"):
-                self.declare_dim(dim, self.globals)
+        main_nodes = [node for statement in main for node in subtrees(statement)]
+        for node in main_nodes:
+            if node.data == "dim":
+                self.declare_dim(node, self.globals)
         bodies = [(routine, self.routine_body(routine)) for routine in self.routines.values()]
         main_key = self.new_key(None)
-        return self.link(bodies, main_key, self.main_body(main))
+        return self.link(bodies, main_key, self.main_body(main, main_nodes))
 
     def declare_dim(self, dim: Tree, table: dict[str, Symbol]) -> None:
         names, type_name, _ = dim.children[1:-2], dim.children[-2], dim.children[-1]
@@ -91,9 +89,11 @@ class Compiler(Commands):
         self.line = position(tree)[0]
         params = [self.declare(name, type_, self.locals) for name, type_ in routine.params]
         block = next(c for c in tree.children if isinstance(c, Tree) and c.data == "block")
-        for dim in block.find_data("dim"):
-            self.declare_dim(dim, self.locals)
-        self.prepare_hidden([block], self.locals)
+        nodes = subtrees(block)
+        for node in nodes:
+            if node.data == "dim":
+                self.declare_dim(node, self.locals)
+        self.prepare_hidden(nodes, self.locals)
         symbols = list(self.locals.values())
         self._locals_seen.append({f"{routine.name.upper()}.{name}": symbol
                                   for name, symbol in self.locals.items()})
@@ -128,10 +128,10 @@ class Compiler(Commands):
                 self.push(DEFAULTS[symbol.type])
                 self.op("STORE")
 
-    def main_body(self, statements: list[Tree]) -> Encoded:
+    def main_body(self, statements: list[Tree], nodes: list[Tree]) -> Encoded:
         self.body = Body()
         self.stop_on_error = True
-        self.prepare_hidden(statements, self.globals)
+        self.prepare_hidden(nodes, self.globals)
         for statement in statements:
             self.statement(statement)
         self.line = 0
@@ -151,39 +151,26 @@ class Compiler(Commands):
             self.suppressed(self.globals[point.name.upper()].key)
             self.push(point.value)
             self.op("STORE")
-        for routine, body in bodies:
-            self.line = position(routine.tree)[0]
-            self.suppressed(routine.key)
+        nested = []             # where each function datum's body starts, and the body
+        for routine, body in bodies + [(None, main)]:
+            self.line = position(routine.tree)[0] if routine else 0
+            self.suppressed(routine.key if routine else main_key)
             self.op("FDEF")
             self.push(Function(body.code))
+            nested.append((len(self.body.code) - len(body.code), body))
         self.line = 0
-        self.suppressed(main_key)
-        self.op("FDEF")
-        self.push(Function(main.code))
         self.evaluate(main_key)
-        parts = [encode_code(code) for code in self.body.codes]
-        table = self.source_map(parts, self.body.lines, [body for _, body in bodies] + [main])
         symbols = {name: s for name, s in self.globals.items()}
         for routine_locals in self._locals_seen:
             symbols.update(routine_locals)
-        return Program(b"".join(parts), self.source, table, symbols)
+        return Program(bytes(self.body.code), self.source, self.source_map(nested), symbols)
 
-    def source_map(self, parts: list[bytes], lines: list[int],
-                   nested: list[Encoded]) -> dict[int, int]:
-        """Offset of every code → its line: the top-level codes and, inside each function datum
-        (in order), the codes of its body."""
-        table: dict[int, int] = {}
-        bodies = iter(nested)
-        offset = 0
-        for code, part, line in zip(self.body.codes, parts, lines):
-            table[offset] = line
-            if code.kind is CodeKind.DATA and isinstance(code.value, Function):
-                body = next(bodies)
-                start = offset + len(part) - len(body.code)
-                for size, inner_line in zip(body.sizes, body.lines):
-                    table[start] = inner_line
-                    start += size
-            offset += len(part)
+    def source_map(self, nested: list[tuple[int, Encoded]]) -> dict[int, int]:
+        """Offset of every code → its line: the top-level codes and, inside each function datum,
+        the codes of its body."""
+        table = dict(zip(self.body.starts, self.body.lines))
+        for start, body in nested:
+            table.update(zip([start + offset for offset in body.starts], body.lines))
         return table
 
     # ---- statements ---------------------------------------------------------------------------
@@ -324,9 +311,9 @@ class Compiler(Commands):
         symbol = self.spare.pop()
         return Symbol(symbol.name, type_, symbol.key, symbol.routine)
 
-    def prepare_hidden(self, trees: list[Tree], table: dict[str, Symbol]) -> None:
-        """One hidden variable for each FOR and each HANDREF in `trees`."""
-        count = sum(1 for tree in trees for node in tree.iter_subtrees()
+    def prepare_hidden(self, nodes: list[Tree], table: dict[str, Symbol]) -> None:
+        """One hidden variable for each FOR and each HANDREF among `nodes`."""
+        count = sum(1 for node in nodes
                     if node.data == "for_block" or node.data in ("call", "name")
                     and node.children[0].upper() == "HANDREF")
         self.spare = []
@@ -337,6 +324,16 @@ class Compiler(Commands):
                             self.routine.name if self.routine else "")
             table[name] = symbol
             self.spare.append(symbol)
+
+
+def subtrees(tree: Tree) -> list[Tree]:
+    """The subtrees of `tree` in the order of lark's `iter_subtrees` (children first), without
+    its bookkeeping for shared nodes: a parse tree shares none."""
+    queue = [tree]
+    for node in queue:
+        queue += [child for child in reversed(node.children) if isinstance(child, Tree)]
+    queue.reverse()
+    return queue
 
 
 def compile_source(source: Source, points: dict[str, Point] | None = None) -> Program:

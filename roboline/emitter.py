@@ -6,10 +6,9 @@ from dataclasses import dataclass, field
 
 from lark import Token, Tree
 
-from strolic.codec import Code, CodeKind, encode_code
-from strolic.codes import I2, Num, UserCode
+from strolic.codes import I2, TagHead, UserCode, make_number
 from strolic.opcodes import BY_MNEMONIC
-from strolic.text import resolve_labels
+from strolic.values import encode_function_code, encode_item, encode_value
 
 from .builtins import TYPES
 from .program import Symbol
@@ -30,20 +29,29 @@ class Routine:
 
 @dataclass
 class Body:
-    """The codes of one function body with their lines, its labels and branch references."""
-    codes: list[Code] = field(default_factory=list)
+    """One function body as it is emitted: its bytes, where each code starts and its line,
+    its labels (byte offsets) and its branches (where the offset goes, the label, where the
+    branch code ends)."""
+    code: bytearray = field(default_factory=bytearray)
+    starts: list[int] = field(default_factory=list)
     lines: list[int] = field(default_factory=list)
     labels: dict[str, int] = field(default_factory=dict)
     references: list[tuple[int, str, int]] = field(default_factory=list)
-    label_lines: dict[str, int] = field(default_factory=dict)
+    label_lines: dict[str, Token] = field(default_factory=dict)
 
 
 @dataclass
 class Encoded:
-    """A function body's bytes, and the line and byte size of each of its codes."""
+    """A function body's bytes, and the byte offset and line of each of its codes."""
     code: bytes
+    starts: list[int]
     lines: list[int]
-    sizes: list[int]
+
+
+# the bytes of the codes emitted most, made once (each code is encoded the first time it is
+# emitted, not kept as an object to encode at the end)
+OPS = {mnemonic: encode_function_code(op.code) for mnemonic, op in BY_MNEMONIC.items()}
+BRANCH_PLACEHOLDER = encode_value(make_number(I2, 0))
 
 
 def named(type_: str) -> str:
@@ -105,22 +113,28 @@ class Emitter:
                              + ", ".join(sorted(TYPES)))
         return TYPES[name.upper()]
 
-    def emit(self, code: Code) -> None:
-        self.body.codes.append(code)
-        self.body.lines.append(self.line)
+    def emit(self, code: bytes) -> None:
+        """One code's bytes, kept with the current line."""
+        body = self.body
+        body.starts.append(len(body.code))
+        body.lines.append(self.line)
+        body.code += code
 
     def op(self, *mnemonics: str) -> None:
         for mnemonic in mnemonics:
-            self.emit(Code(CodeKind.CALL, BY_MNEMONIC[mnemonic].code, 0, 0))
+            self.emit(OPS[mnemonic])
 
     def push(self, value) -> None:
-        self.emit(Code(CodeKind.DATA, value, 0, 0))
+        self.emit(encode_value(value))
 
     def suppressed(self, key: int) -> None:
-        self.emit(Code(CodeKind.SUPPRESSED, UserCode(key), 0, 0))
+        self.emit(encode_item(UserCode(key)))
+
+    def suppressed_tag(self, head: TagHead) -> None:
+        self.emit(encode_item(head))
 
     def evaluate(self, key: int) -> None:
-        self.emit(Code(CodeKind.CALL, key, 0, 0))
+        self.emit(encode_function_code(key))
 
     def new_label(self) -> str:
         self.serial += 1
@@ -129,25 +143,29 @@ class Emitter:
     def place(self, label: str, node=None) -> None:
         if label in self.body.labels:
             raise self.error(node, f"label {label} is defined twice in this routine")
-        self.body.labels[label] = len(self.body.codes)
+        self.body.labels[label] = len(self.body.code)
 
     def branch(self, label: str, mnemonic: str, node=None) -> None:
-        self.body.references.append((len(self.body.codes), label, self.line))
+        """An I2 offset (to the label, from the end of the branch code) and the branch code."""
         if node is not None:
             self.body.label_lines.setdefault(label, node)
-        self.push(Num(I2, 0))
+        at = len(self.body.code)
+        self.emit(BRANCH_PLACEHOLDER)
         self.op(mnemonic)
+        self.body.references.append((at, label, len(self.body.code)))
 
     def finish_body(self) -> Encoded:
-        """The body's bytes (ending in END) and the lines of its codes."""
+        """The body's bytes (ending in END, the branch offsets filled in) and the places and
+        lines of its codes."""
         self.op("END")
-        for _, label, _ in self.body.references:
-            if label not in self.body.labels:
-                raise self.error(self.body.label_lines[label], f"label {label} is not defined "
+        body = self.body
+        for at, label, end in body.references:
+            if label not in body.labels:
+                raise self.error(body.label_lines[label], f"label {label} is not defined "
                                  "in this routine")
-        codes = resolve_labels(self.body.codes, self.body.labels, self.body.references)
-        parts = [encode_code(code) for code in codes]
-        return Encoded(b"".join(parts), self.body.lines, [len(part) for part in parts])
+            body.code[at:at + len(BRANCH_PLACEHOLDER)] = encode_value(
+                make_number(I2, body.labels[label] - end))
+        return Encoded(bytes(body.code), body.starts, body.lines)
 
     def check_count(self, args: list, count: int, node) -> None:
         if len(args) != count:

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 from lark import Tree
 
-from strolic.codec import Code, CodeKind
 from strolic.codes import I4, POSE, R8, Num, Str, TagHead, make_number
 
 from .builtins import FORMATS, FUNCTIONS, NUMERIC, POSE_BYTES, ROBOT
@@ -114,7 +113,7 @@ class Expressions(Emitter):
         for arg in args:
             self.convert(self.expr(arg), "real", arg)
         self.push(make_number(I4, len(args)))
-        self.emit(Code(CodeKind.SUPPRESSED, TagHead(R8), 0, 0))
+        self.suppressed_tag(TagHead(R8))
         self.op("CONSA")
         return "joint"
 
@@ -125,7 +124,7 @@ class Expressions(Emitter):
         for arg in args:
             self.argument(arg, "pose")
         self.push(make_number(I4, len(args)))
-        self.emit(Code(CodeKind.SUPPRESSED, TagHead(POSE, POSE_BYTES), 0, 0))
+        self.suppressed_tag(TagHead(POSE, POSE_BYTES))
         self.op("CONSA")
         return "path"
 
