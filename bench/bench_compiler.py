@@ -11,11 +11,13 @@ import sys
 import time
 from pathlib import Path
 
+import lark
+
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from roboline import Source, compile_source, parse_points  # noqa: E402
-from roboline.parser import parse  # noqa: E402
+from roboline.parser import GRAMMAR, parse, parser  # noqa: E402
 from strolic.text import assemble, disassemble  # noqa: E402
 
 BLOCK = """' block {i}
@@ -84,6 +86,12 @@ def compile_time(repeats: int) -> None:
     print(f"                                            {shown(baseline)}")
     print(f"  ratio compile / assemble (median): wall {ours[1] / baseline[1]:.2f}, "
           f"CPU {ours[3] / baseline[3]:.2f}")
+    built = best(lambda: lark.Lark(GRAMMAR.read_text(), parser="lalr", maybe_placeholders=True),
+                 max(3, repeats // 4))
+    loaded = best(lambda: (parser.cache_clear(), parser()), max(3, repeats // 4))
+    print("  the parser, once a process (a command's or a node's first compile):")
+    print(f"    built from the grammar:                {shown(built)}")
+    print(f"    loaded from the user's cache:          {shown(loaded)}")
 
 
 def check_time() -> None:

@@ -2,6 +2,8 @@
 `SourceError` that names the place and what was expected there."""
 from __future__ import annotations
 
+import hashlib
+import os
 from functools import lru_cache
 from pathlib import Path
 
@@ -18,7 +20,18 @@ TERMINAL_NAMES = {"_NL": "the end of the line", "NAME": "a name", "NUMBER": "a n
 
 @lru_cache(maxsize=1)
 def parser() -> lark.Lark:
-    return lark.Lark(GRAMMAR.read_text(), parser="lalr", maybe_placeholders=True)
+    """Built once a process. Its LALR tables are kept in the user's cache directory (lark
+    checks they are of this grammar, lark and Python), so that a new process (the command,
+    a node) loads them instead of building them: ~40 ms -> ~5-15 ms CPU."""
+    text = GRAMMAR.read_text()
+    options = {"parser": "lalr", "maybe_placeholders": True}
+    cache = (Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "roboline"
+             / f"grammar-{hashlib.md5(text.encode()).hexdigest()}.lark")
+    try:
+        cache.parent.mkdir(parents=True, exist_ok=True)
+        return lark.Lark(text, cache=str(cache), **options)
+    except OSError:             # no cache where none can be written
+        return lark.Lark(text, **options)
 
 
 def parse(source: Source) -> lark.Tree:

@@ -201,3 +201,30 @@ def test_command_line(tmp_path):
     bad = subprocess.run(env_python + ["check", str(tmp_path / "none.rbl")], cwd=ROOT,
                          capture_output=True, text=True)
     assert bad.returncode == 2 and "none.rbl" in bad.stderr
+
+
+@pytest.mark.parametrize("cache_state", ["written then loaded", "corrupt", "unwritable"])
+def test_the_parser_cache_never_stands_in_the_way(tmp_path, monkeypatch, cache_state):
+    """A new process loads the parser's tables from the user's cache; a damaged cache or one
+    that cannot be written only costs the time to build them."""
+    import hashlib
+
+    from roboline import parser as parser_module
+    grammar = parser_module.GRAMMAR.read_text()
+    cached = tmp_path / "roboline" / f"grammar-{hashlib.md5(grammar.encode()).hexdigest()}.lark"
+    if cache_state == "corrupt":
+        cached.parent.mkdir()
+        cached.write_bytes(b"garbage\n")
+    if cache_state == "unwritable":
+        (tmp_path / "roboline").write_text("a file where the cache directory would be")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    try:
+        for _ in range(2):                      # the second time from the cache, if any
+            parser_module.parser.cache_clear()
+            program = compile_source(Source("DIM i AS INT\ni = 2 * 3\nPRINT i\n"))
+            host = Host()
+            VM(host).run(program.code)
+            assert shown_output(host.output) == ['"6"']
+    finally:
+        parser_module.parser.cache_clear()
+    assert cached.exists() == (cache_state != "unwritable")
