@@ -14,7 +14,7 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 
 from acti_bringup.recording.recorder import Recorder
-from acti_bringup.serving.spinning import SpinLoop, init, wait_for_signal
+from acti_bringup.serving.spinning import SpinLoop, catch_signals, init, wait_for_signal
 from acti_record.writing import COMPRESSIONS, Recording
 
 
@@ -43,6 +43,7 @@ def main(args: list[str] | None = None) -> None:
     argv = sys.argv if args is None else args
     own = argv[1:argv.index("--ros-args")] if "--ros-args" in argv else argv[1:]
     options = parse(own)
+    catch_signals()             # from here on SIGINT/SIGTERM close the file (once it is open)
     try:
         recording = Recording(options.path, int(options.max_size * 1e6), options.max_duration,
                               options.compression)

@@ -8,6 +8,7 @@ import subprocess
 import sys
 
 import pytest
+from mcap.reader import make_reader
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
@@ -187,3 +188,19 @@ def test_an_unknown_introspection_setting_stops_the_job_with_one_line(tmp_path):
     out = refused.stdout + refused.stderr
     assert refused.returncode == 2 and "Traceback" not in out, out
     assert "service_introspection is 'everything': use one of disabled, metadata, contents" in out
+
+
+def test_sigterm_ends_a_recording_with_a_complete_file(tmp_path):
+    path = str(tmp_path / "term.mcap")
+    rec = recorder(path, "/nothing_here")
+    try:
+        assert wait_until(lambda: os.path.exists(path), 60.0)
+        assert rec.poll() is None
+    finally:
+        rec.send_signal(signal.SIGTERM)
+        code = rec.wait(timeout=30)
+    assert code == 0 and "recorded 0 messages" in rec.stdout.read()
+    with open(path, "rb") as f:                        # summary and footer written
+        reader = make_reader(f)
+        assert reader.get_summary() is not None
+        assert [m.name for m in reader.iter_metadata()] == ["rosbag2"]
