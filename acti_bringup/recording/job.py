@@ -4,6 +4,7 @@ job (`python -m acti_bringup.record`, a process of its own: writing costs the jo
 nothing) and stopped with it, which closes the file."""
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
@@ -18,6 +19,7 @@ from acti_bringup.serving.parameters import declare_config
 
 RECORDER_STOP_S = 10.0
 RECORDER_READY_S = 30.0
+RECORDER_NICE = 0
 
 
 @dataclass
@@ -28,6 +30,14 @@ class RecordingConfig:
     # record everything (every topic, service call and action) from start-up into this MCAP
     # file, closed when the job ends (python -m acti_bringup.record); "": no recording
     record: str = ""
+
+
+def _recorder_process() -> None:
+    """In the recorder's process: ends with the job, and runs at ordinary niceness or lower,
+    behind the job's threads (the job's `nice` lowers theirs, -10 by default; raising a
+    niceness needs no privilege)."""
+    _end_with_parent()
+    os.setpriority(os.PRIO_PROCESS, 0, max(os.getpriority(os.PRIO_PROCESS, 0), RECORDER_NICE))
 
 
 class JobRecording:
@@ -43,7 +53,7 @@ class JobRecording:
         if c.record:
             self._recorder = subprocess.Popen(
                 [sys.executable, "-m", "acti_bringup.record", c.record, "--ros-args",
-                 "-r", f"__ns:={node.get_namespace()}"], preexec_fn=_end_with_parent)
+                 "-r", f"__ns:={node.get_namespace()}"], preexec_fn=_recorder_process)
             self._log.info(f"recording to {c.record} (the recorder's process: "
                            f"{self._recorder.pid})")
 
