@@ -2,6 +2,7 @@
 without touching the other, each publishing its own simulated time and joints in its namespace
 (published only while subscribed: these subscriptions start them)."""
 import os
+import re
 
 from acti_msgs import srv
 from diagnostic_msgs.msg import DiagnosticArray
@@ -115,8 +116,11 @@ def test_a_second_job_in_a_robots_namespace_refuses_to_start(robot1, robot2, tmp
         twin.stop()
     fatal = [line for line in twin.log().splitlines() if line.startswith("[FATAL]")]
     assert len(fatal) == 1 and "Traceback" not in twin.log(), twin.log()
-    assert "/robot2/acti_middle_node, /robot2/vehicle_node, /robot2/acti_view already served" \
-        in fatal[0] and "-r __ns:=" in fatal[0] and "allow_namesakes:=true" in fatal[0], fatal[0]
+    # the names discovery found within its second (all three, as a rule; on a busy machine, some)
+    assert re.search(r"cannot start: /robot2/(acti_middle_node|vehicle_node|acti_view)"
+                     r"(, /robot2/(vehicle_node|acti_view))* already served in ROS_DOMAIN_ID=",
+                     fatal[0]), fatal[0]
+    assert "-r __ns:=" in fatal[0] and "allow_namesakes:=true" in fatal[0], fatal[0]
 
 
 def test_a_second_job_allowed_in_a_robots_namespace_is_reported(ros, robot1, robot2, tmp_path):

@@ -23,6 +23,7 @@ import os
 import signal
 import sys
 import threading
+import time
 from typing import Callable, Iterable, NoReturn, TypeVar
 
 import rclpy
@@ -39,7 +40,7 @@ from rclpy.publisher import Publisher
 from rclpy.timer import Timer
 
 from acti_bringup.serving.logs import route_python_logging
-from acti_bringup.serving.namesakes import JobConfig, namesakes, refusal
+from acti_bringup.serving.namesakes import DISCOVERY_WAIT_S, JobConfig, namesakes, refusal
 from acti_bringup.serving.outbox import Outbox, unlock_action, unlocked_publish
 from acti_bringup.serving.parameters import declare_config
 from acti_bringup.serving.params_files import warn_of_unmatched_files
@@ -66,6 +67,8 @@ def stop_requested() -> bool:
 
 
 _given_args: list[str] = []        # the process's arguments, as `init` got them
+_init_at = [0.0]                   # when `init` ran (time.monotonic())
+DISCOVERY_FROM_INIT_S = 6.0
 MAX_DOMAIN_ID = 232     # Fast DDS: 7400 + 250 × domain + offsets must stay a UDP port
 
 
@@ -75,6 +78,7 @@ def init(args: list[str]) -> None:
     DDS cannot use end the process as a refused setting does (`build_or_exit`). (`--help` is
     answered before: `acti_bringup.serving.usage`.)"""
     _given_args[:] = args
+    _init_at[0] = time.monotonic()
     catch_signals()
     domain = os.environ.get("ROS_DOMAIN_ID", "").strip()
     if domain and not (domain.isdigit() and int(domain) <= MAX_DOMAIN_ID):
@@ -117,7 +121,10 @@ def build_or_exit(build: Callable[[], T], name: str, builder: str = "") -> T:
         allowed = declare_job_parameters(nodes).allow_namesakes
         warn_of_unknown_parameters(nodes)
         warn_of_unmatched_files(nodes, _given_args, nodes[0].get_logger().warning)
-        taken = [] if allowed else namesakes(nodes)
+        # discovery learns the other jobs' nodes over seconds from the start (longer on a busy
+        # machine): look until DISCOVERY_FROM_INIT_S after init, and at least DISCOVERY_WAIT_S
+        wait_s = max(DISCOVERY_WAIT_S, _init_at[0] + DISCOVERY_FROM_INIT_S - time.monotonic())
+        taken = [] if allowed else namesakes(nodes, wait_s)
         if taken:
             _cannot_start(name, refusal(taken))
         if builder:
