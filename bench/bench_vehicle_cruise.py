@@ -1,7 +1,9 @@
 """moveCruiseAbs against the time-optimal bound: the same path (spline through the points) and
 limits, timed by TOPP-RA on a fine grid. Simulated seconds; no ROS (the core on its own world).
 Then the planning cost of adding points one by one (wall time per call, first and last tenth):
-flat when adding a point costs the same however many came before."""
+flat when adding a point costs the same however many came before. Last, set_velocity
+re-plans beside the simulation step, planned here and in the planning process (`--replan`:
+only that part)."""
 from __future__ import annotations
 
 import math
@@ -9,6 +11,8 @@ import os
 import sys
 import threading
 import time
+
+import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -84,21 +88,28 @@ def adding_points(n: int) -> None:
           f"max {1000 * max(wall):6.1f} ms")
 
 
-def stop_while_planning(trials: int = 20) -> None:
-    """The core's control plane while another thread plans: a cruise runs (the simulation on its
-    own thread, real time), a thread adds a far cruise point (a long re-plan), and stop is called
-    as that plan starts. Wall time of stop and of get_state, and the largest gap between two
-    simulation steps meanwhile, against the control period."""
+def stepping_base() -> tuple[World, MotionExecutor, VehicleCore, list[float]]:
+    """A base, powered with the servo on, stepped in real time on the executor's own thread;
+    the list fills with the wall time (perf_counter) of every step."""
     world = World()
     executor = MotionExecutor(world, real_time_factor=1.0)
     base = VehicleCore(executor)
     steps: list[float] = []
     executor.after_step(lambda _: steps.append(time.perf_counter()))
     executor.start()
+    base.set_power(True)
+    base.set_servo(True)
+    return world, executor, base, steps
+
+
+def stop_while_planning(trials: int = 20) -> None:
+    """The core's control plane while another thread plans: a cruise runs (the simulation on its
+    own thread, real time), a thread adds a far cruise point (a long re-plan), and stop is called
+    as that plan starts. Wall time of stop and of get_state, and the largest gap between two
+    simulation steps meanwhile, against the control period."""
+    world, executor, base, steps = stepping_base()
     stops, states, gaps, plans = [], [], [], []
     try:
-        base.set_power(True)
-        base.set_servo(True)
         for _ in range(trials):
             base.set_position((0.0, 0.0, 0.0))
             base.move_cruise_abs((3000.0, 500.0))
@@ -137,9 +148,64 @@ def stop_while_planning(trials: int = 20) -> None:
     print(f"  largest gap between simulation steps: p50 {pct(gaps, 0.5):.1f} ms, max {pct(gaps, 1.0):.1f} ms")
 
 
-if __name__ == "__main__":
+def replanning_beside_the_step(rounds: int = 6, seconds: float = 2.0) -> None:
+    """set_velocity re-plans a running cruise (8 points, 4.8 m) back to back for `seconds`,
+    with the plans in this process (as before) and in the planning process (acti_motion.vehicle
+    .planner), interleaved with rounds that only cruise (the baseline). Per mode: this
+    process's CPU per re-plan (the calling thread's: what holds the GIL the simulation step
+    needs), the answer's wall time, and the largest gap between two simulation steps (real
+    time: one step is 4.17 ms) per round."""
+    from acti_motion.vehicle import planner
+    world, executor, base, stamps = stepping_base()
+    figures: dict[str, tuple[list[float], list[float], list[float]]] = {}
+    try:
+        for _ in range(rounds):
+            for mode in ("cruise only", "plans here", "plans in the planning process"):
+                if mode.endswith("process"):
+                    planner.start()
+                    planner.wait_ready()
+                cpu, wall, gaps = figures.setdefault(mode, ([], [], []))
+                base.set_position((0.0, 0.0, 0.0))
+                base.set_velocity((600.0, 60.0))
+                for i in range(8):
+                    base.move_cruise_abs((600.0 * (i + 1), 400.0 * (i % 2)))
+                while base.odometry.v < 0.3:
+                    time.sleep(0.005)
+                stamps.clear()
+                end, k = time.perf_counter() + seconds, 0
+                while time.perf_counter() < end:
+                    if mode == "cruise only":
+                        time.sleep(0.05)
+                        continue
+                    c0, t0 = time.thread_time(), time.perf_counter()
+                    base.set_velocity((400.0 if k % 2 else 600.0, 60.0))
+                    wall.append(time.perf_counter() - t0)
+                    cpu.append(time.thread_time() - c0)
+                    k += 1
+                gaps.append(max(b - a for a, b in zip(stamps, stamps[1:])))
+                base.stop()
+                while base.device.busy:
+                    time.sleep(0.01)
+                planner.stop()
+    finally:
+        executor.shutdown()
+        world.close()
+    print(f"set_velocity re-plans of a running cruise, back to back ({rounds} interleaved rounds "
+          f"of {seconds:g} s per mode; control period {1000 * executor.dt:.2f} ms):")
+    for mode, (cpu, wall, gaps) in figures.items():
+        ms = lambda v, q: 1000.0 * float(np.quantile(v, q))  # noqa: E731
+        plans = (f"this process's CPU per re-plan p50 {ms(cpu, 0.5):6.1f} ms; answer p50 "
+                 f"{ms(wall, 0.5):6.1f} ms, max {ms(wall, 1.0):6.1f} ms; " if cpu else "")
+        print(f"  {mode:30s} {plans}largest step gap per round: p50 {ms(gaps, 0.5):5.1f} ms, "
+              f"max {ms(gaps, 1.0):5.1f} ms")
+
+
+if __name__ == "__main__" and sys.argv[1:] == ["--replan"]:
+    replanning_beside_the_step()          # only this part (python bench/bench_vehicle_cruise.py --replan)
+elif __name__ == "__main__":
     main()
     print("planning cost of cruise points added one by one (a queued cruise; wall time):")
     for count in (10, 50, 200):
         adding_points(count)
     stop_while_planning()
+    replanning_beside_the_step()

@@ -39,6 +39,7 @@ from acti_bringup.surroundings.world_map import MapPublisher
 from acti_bringup.visual.transforms import planar_transform, tf_publisher
 from acti_motion.vehicle.paths import Odometry as WheelOdometry, Pose2D
 from acti_motion.replies import Reply
+from acti_motion.vehicle import planner
 from acti_motion.vehicle.core import VehicleConfig, VehicleCore
 from acti_motion.vehicle.alarms import AlarmType
 from acti_motion.vehicle.obstacles import ObstacleConfig
@@ -111,6 +112,7 @@ class VehicleNode(Node):
     def __init__(self, simulation: Simulation | None = None) -> None:
         super().__init__("vehicle_node")
         self.simulation = simulation or Simulation(self)
+        planner.start()        # TOPP-RA plans in a process of their own: the step never waits
         self.core = VehicleCore(self.simulation.executor, declare_config(self, VehicleConfig),
                                 declare_config(self, ObstacleConfig))
         self.motion, self.goals = Plane(self, "motion"), Plane(self, "goals")

@@ -21,9 +21,9 @@ from acti_motion.replies import Refused
 from acti_motion.vehicle.alarms import Alarms, Kind
 from acti_motion.vehicle.config import VehicleConfig, check_config
 from acti_motion.vehicle.control import FIRMWARE_VERSION, IF_VERSION, WHEEL_AXES, Control
-from acti_motion.vehicle.cruise import plan_curve
+from acti_motion.vehicle.cruise import warm_up
 from acti_motion.vehicle.obstacles import ObstacleConfig, Obstacles
-from acti_motion.vehicle.paths import Odometry, Pose2D
+from acti_motion.vehicle.paths import Odometry
 from acti_motion.vehicle.planning import (LOOKAHEAD_GROWTH, LOOKAHEAD_STEPS, PAUSED, PAUSED_DRIVE,
                                           Planning)
 from acti_motion.vehicle.refusals import bounded_pair
@@ -90,12 +90,8 @@ class VehicleCore(Control, Planning, Sensing, Obstacles):
         self._stick = (0.0, 0.0)             # the last Joy sample's deflections that drove the base
         self._dt = executor.dt
         self._init_obstacles(obstacles or ObstacleConfig(), world)
-        self._warm_up()
+        warm_up(self._limits())           # the first request does not pay for first-use costs
         executor.before_step(self._sense)
-
-    def _warm_up(self) -> None:
-        """Plan one short cruise now, so the first request does not pay for first-use costs."""
-        plan_curve(Pose2D(0.0, 0.0, 0.0), [(0.5, 0.2), (1.0, 0.0)], self._limits())
 
     def _accepted_motion(self) -> None:
         """Both paths: an accepted motion, and stop, end Stuck (and a pending or running

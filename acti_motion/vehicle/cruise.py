@@ -22,6 +22,7 @@ from scipy.interpolate import make_interp_spline
 from acti_motion.vehicle.paths import (Chain, CurvePath, Odometry, Path, Pose2D, SampledPath,
                                        TrackedBaseMotion, straight_to, turn, velocity_path,
                                        wrap_angle)
+from acti_motion.vehicle.planner import planned
 
 # Every plan's cost is bounded by these caps, whatever the path's length or the speed settings.
 SAMPLE_DT = 0.005            # s between samples of the timed path …
@@ -126,6 +127,12 @@ def plan_curve(start: Pose2D, points: Sequence[tuple[float, float]],
     return plan
 
 
+def warm_up(limits: tuple[float, float, float, float] = (0.3, 0.8, 0.5, 1.6)) -> None:
+    """Plan one short cruise, so that the first request does not pay for first-use costs."""
+    plan_curve(Pose2D(0.0, 0.0, 0.0), [(0.5, 0.2), (1.0, 0.0)], limits)
+
+
+@planned
 def _plan_curve(start: Pose2D, points: Sequence[tuple[float, float]],
                 limits: tuple[float, float, float, float], v0: float,
                 curvature: float) -> CurvePlan | None:
@@ -133,6 +140,7 @@ def _plan_curve(start: Pose2D, points: Sequence[tuple[float, float]],
     return None if geometry is None else timed_path(*geometry, limits, v0)
 
 
+@planned
 def timed_path(s: np.ndarray, x: np.ndarray, y: np.ndarray, heading: np.ndarray,
                s_points: Sequence[float], limits: tuple[float, float, float, float],
                v0: float) -> CurvePlan | None:
@@ -151,6 +159,21 @@ def timed_path(s: np.ndarray, x: np.ndarray, y: np.ndarray, heading: np.ndarray,
     path.x[-1], path.y[-1], path.v[-1], path.w[-1] = x[-1], y[-1], 0.0, 0.0
     via = [float(np.interp(sp, st, ts)) for sp in s_points]
     return CurvePlan(path, via)
+
+
+@planned
+def retimed_rest(path: Path, local: float, via: Sequence[float],
+                 limits: tuple[float, float, float, float], v0: float) -> CurvePlan | None:
+    """The rest of `path` from its time `local` on (its geometry, sampled), timed by TOPP-RA
+    for `limits` from speed v0 to rest, with the times at which it passes the path times `via`."""
+    times = np.linspace(local, path.duration, RETIME_SAMPLES)
+    poses = [path.pose(float(tau)) for tau in times]
+    xy = np.array([(p.x, p.y) for p in poses])
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
+    keep = np.concatenate([[True], np.diff(s) > 1e-7])
+    heading = np.array([p.theta for p in poses])
+    s_points = [float(np.interp(tp, times, s)) for tp in via]
+    return timed_path(s[keep], xy[keep, 0], xy[keep, 1], heading[keep], s_points, limits, v0)
 
 
 ALIGN_TOLERANCE = math.radians(1.0)   # from rest, turn toward the first point when off by more
@@ -216,18 +239,11 @@ class CruiseMotion(TrackedBaseMotion):
         v0 = self.reference_twist(t)[0]
         if (st.from_rest and local <= st.curve_from) or not ahead or v0 <= 1e-4:
             return None
-        times = np.linspace(local, path.duration, RETIME_SAMPLES)
-        poses = [path.pose(float(tau)) for tau in times]
-        xy = np.array([(p.x, p.y) for p in poses])
-        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
-        keep = np.concatenate([[True], np.diff(s) > 1e-7])
-        heading = np.array([p.theta for p in poses])
-        s_points = [float(np.interp(tp, times, s)) for _, tp in ahead]
-        plan = timed_path(s[keep], xy[keep, 0], xy[keep, 1], heading[keep], s_points, limits, v0)
+        plan = retimed_rest(path, local, [tp for _, tp in ahead], limits, v0)
         if plan is None:
             return None
         return CruiseState(tuple(p for p, _ in ahead), tuple(plan.via_times), False, 0.0, limits, t,
-                           Chain([plan.path], poses[0]))
+                           Chain([plan.path], path.pose(local)))
 
     def move_frame(self, frame: Pose2D) -> None:
         super().move_frame(frame)
