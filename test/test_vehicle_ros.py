@@ -248,3 +248,32 @@ def test_wait_motion_action(ros, vehicle):
     finally:
         client.destroy()
     assert vehicle.alive()
+
+
+def test_ready_only_moves_no_length_moves_and_a_pause_then_stop_over_dds(ros, vehicle):
+    """1.4.17: refused (false) in Warning-104; a move of no length leaves the base Ready, so a
+    Ready-only move right after it is taken; a pause before a move starts, then stop, leaves the
+    next move able to run."""
+    from acti_msgs.action import VehicleWaitMotion
+    from ros_harness import Actions
+    waits = Actions(ros, VehicleWaitMotion, BASE + "wait_motion")
+    assert call(ros, "set_power", on_off=True).success and call(ros, "set_servo", on_off=True).success
+    call(ros, "stop")
+    assert wait_until(lambda: state(ros) == 0x010 or not call(ros, "clear_alarm"), 20.0)
+    assert not call(ros, "set_output", ioid=77, output=1, mask=1).success
+    assert call(ros, "get_state").msg == "Warning-104"
+    r = call(ros, "move_forward", x=100.0)
+    assert not r.success and "Warning-104" in r.message and "clear_alarm" in r.message
+    assert call(ros, "clear_alarm").success and state(ros) == 0x010
+    assert call(ros, "move_forward", x=0.0).success
+    r = call(ros, "move_forward", x=100.0)                  # at once: no 400 ms of Busy
+    assert r.success, r.message
+    _, result = waits.result(waits.send(motion_id=r.motion_id, timeout=30.0))
+    assert result.completed
+    assert call(ros, "pause").success and state(ros) == 0x015
+    assert call(ros, "move_forward", x=50.0).success           # kept for resume …
+    assert call(ros, "stop").success and state(ros) == 0x010   # … and discarded by the stop
+    r = call(ros, "move_forward", x=50.0)
+    assert r.success and not r.message
+    _, result = waits.result(waits.send(motion_id=r.motion_id, timeout=30.0))
+    assert result.completed, result.message
