@@ -42,6 +42,8 @@ setup:
 	$(STAGE) "venv, the build's wheels (ROS 2 Python, colcon, ccache)" $(SETUP_LOG)/venv.log \
 	  $(SUBMAKE) $(BUILD_DEPS_STAMP) $(ACTIVATE_HOOK) && \
 	$(SUBMAKE) -j2 stage-interfaces stage-wheels && \
+	$(STAGE) "the parameters list --help prints (kept in build/usage/)" $(SETUP_LOG)/usage.log \
+	  bash -c '$(ENV) && python -m acti_bringup --help' && \
 	took=$$((SECONDS - start)) && printf 'setup done in %d:%02d\n' $$((took / 60)) $$((took % 60))
 
 stage-interfaces:
