@@ -230,7 +230,8 @@ def test_stop_or_servo_off_of_a_paused_arm_at_rest_answers_not_moving_at_once(ro
         assert call(ros, "move_ptp_joint_rel", srv.MovePTPJointRel,
                     joint_points=[4.0] * 7).return_id.id == 0
         assert call(ros, "pause", srv.Pause).return_id.id == 0
-        assert wait_until(lambda: call(ros, "get_state", srv.GetState).state == 0x11, 10.0)
+        assert wait_until(lambda: call(ros, "get_state", srv.GetState).state == 0x11, 30.0), \
+            call(ros, "get_state", srv.GetState).state
         assert call(ros, halt, halt_type).return_id.id == 0
         assert call(ros, "get_state", srv.GetState).state == after
     ready(ros)
