@@ -134,7 +134,8 @@ def test_real_time_scheduling_takes_the_control_loop_and_the_outbox_that_sends_i
     try:
         assert wait_until(lambda: "services under" in node.log(), 60.0), node.log()
         ros.call(srv.GetState, ARM + "get_state")
-        assert wait_until(lambda: sorted(rt_priorities(node.proc.pid))[-2:] == [10, 10], 30.0)
+        assert wait_until(lambda: sorted(rt_priorities(node.proc.pid))[-2:] == [10, 10], 30.0), \
+            (sorted(rt_priorities(node.proc.pid)), node.log())
         assert sorted(rt_priorities(node.proc.pid))[-3:] == [0, 10, 10]
     finally:
         node.stop()
