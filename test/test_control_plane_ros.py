@@ -106,31 +106,41 @@ def stat(path: str) -> list[str]:
         return f.read().rsplit(")", 1)[1].split()
 
 
+def task_stats(pid: int) -> list[list[str]]:
+    """`stat` of every thread of process `pid` that still runs once read (threads come and go)."""
+    tasks = f"/proc/{pid}/task"
+    stats = []
+    for tid in os.listdir(tasks):
+        try:
+            stats.append(stat(f"{tasks}/{tid}"))
+        except (FileNotFoundError, ProcessLookupError):
+            pass
+    return stats
+
+
 def rt_priorities(pid: int) -> list[int]:
     """The real-time priority of every thread of process `pid` (0: ordinary scheduling)."""
-    tasks = f"/proc/{pid}/task"
-    return [int(stat(f"{tasks}/{tid}")[37]) for tid in os.listdir(tasks)]
+    return [int(fields[37]) for fields in task_stats(pid)]
 
 
 @pytest.mark.skipif(os.geteuid() != 0, reason="lowering the niceness needs root")
 def test_every_thread_of_the_job_runs_above_the_clients(ros, job):
     ros.call(srv.GetState, ARM + "get_state")            # the job serves
 
-    def nice(path: str) -> int:
-        return int(stat(path)[16])
-    tasks = f"/proc/{job.proc.pid}/task"
-    assert {nice(f"{tasks}/{tid}") for tid in os.listdir(tasks)} == {-10}
-    assert nice(f"/proc/{os.getpid()}") == 0
+    threads = task_stats(job.proc.pid)
+    assert {int(fields[16]) for fields in threads} == {-10}
+    assert int(stat(f"/proc/{os.getpid()}")[16]) == 0
     # real-time scheduling is opt-in (control_fifo_priority): by default no thread has it
     assert set(rt_priorities(job.proc.pid)) == {0}
-    assert {stat(f"{tasks}/{tid}")[38] for tid in os.listdir(tasks)} == {"0"}    # SCHED_OTHER
+    assert {fields[38] for fields in task_stats(job.proc.pid)} == {"0"}    # SCHED_OTHER
 
 
 @pytest.mark.skipif(os.geteuid() != 0, reason="real-time scheduling needs root")
 def test_real_time_scheduling_takes_the_control_loop_and_the_outbox_that_sends_its_messages(
         ros, tmp_path):
     node = NodeProcess("acti_middle_node", str(tmp_path / "node.log"),
-                       "control_fifo_priority:=10")
+                       "control_fifo_priority:=10",
+                       "allow_namesakes:=true")       # the module's job may still run beside it
     try:
         assert wait_until(lambda: "services under" in node.log(), 60.0), node.log()
         ros.call(srv.GetState, ARM + "get_state")
