@@ -9,16 +9,20 @@ from __future__ import annotations
 
 import glob
 import os
+import shlex
 import struct
 from dataclasses import dataclass, field
+from typing import Iterator
 
 import yaml
-from mcap.exceptions import McapError
-from mcap.records import Channel as McapChannel, Message as McapMessage, Schema
-from mcap.stream_reader import StreamReader
+from mcap.exceptions import EndOfFile, McapError
+from mcap.records import (Channel as McapChannel, Chunk, DataEnd, McapRecord,
+                          Message as McapMessage, Schema)
+from mcap.stream_reader import StreamReader, breakup_chunk
 
 
 MAGIC = b"\x89MCAP0\r\n"
+REINDEX_COMMAND = "python -m acti_bringup.reindex"   # rewrites a file cut short whole
 
 
 class BadRecording(Exception):
@@ -79,61 +83,104 @@ def _split_index(path: str) -> tuple[int, str]:
 
 
 def read_recording(path: str) -> Contents:
-    """Every readable message of the recording `path` (`recording_files`), by log time."""
+    """Every readable message of the recording `path` (`recording_files`), by log time. A file
+    of several that cannot be read is a problem of the recording (a recorder killed as it
+    started its next split file leaves one without a chunk); when none can, it is refused."""
     contents = Contents(recording_files(path))
-    problems = []
+    problems, refused = [], []
     for file in contents.files:
-        problem = _read_file(file, contents.messages)
+        try:
+            problem = _read_file(file, contents.messages)
+        except BadRecording as e:        # one of split files (the last one, just started)
+            refused.append(e)
+            problem = str(e)
         if problem:
             problems.append(problem)
+    if len(refused) == len(contents.files):
+        raise refused[0]
     contents.messages.sort(key=lambda m: m.log_ns)
     contents.problem = "; ".join(problems)
     return contents
 
 
 # what a damaged file raises from inside the mcap reader
-_DAMAGE = (McapError, struct.error, ValueError, UnicodeDecodeError, EOFError, MemoryError)
+READ_ERRORS = (McapError, struct.error, ValueError, UnicodeDecodeError, EOFError, MemoryError)
+RECORD_LIMIT = 1 << 30        # a longer record is damage, not a record
+
+
+class FileRecords:
+    """The records of one MCAP file in file order, the chunks' records in place of each chunk,
+    read one after another without the summary, so that a file cut short gives every record
+    before the cut. Once iterated: `complete` (its footer was read), else `problem` says where
+    it was cut and what was read ("ends early …"); `compression`: its chunks' ("" none)."""
+
+    def __init__(self, path: str) -> None:
+        self.path = path
+        self.compression = ""
+        self.messages = 0
+        self.complete = False
+        self.problem = ""
+
+    def __iter__(self) -> Iterator[McapRecord]:
+        content, data_ended = False, False
+        try:
+            with open(self.path, "rb") as f:
+                if f.read(len(MAGIC)) != MAGIC:
+                    raise BadRecording(f"{self.path}: not an MCAP recording (it does not start "
+                                       "as one)")
+                f.seek(0)
+                for record in StreamReader(f, emit_chunks=True,
+                                           record_size_limit=RECORD_LIMIT).records:
+                    if isinstance(record, Chunk):
+                        self.compression = self.compression or record.compression
+                    for inner in breakup_chunk(record) if isinstance(record, Chunk) else (record,):
+                        content |= isinstance(inner, (Schema, McapChannel, McapMessage))
+                        self.messages += isinstance(inner, McapMessage)
+                        yield inner
+                    data_ended |= isinstance(record, DataEnd)
+            self.complete = True
+        except OSError as e:
+            raise BadRecording(f"{self.path}: cannot be read: {e.strerror or e}") from None
+        except READ_ERRORS as e:
+            if not content:
+                raise BadRecording(f"{self.path}: an MCAP file without a complete chunk "
+                                   f"({_what(e)}: was its recorder killed as it started?)") from None
+            self.problem = (
+                f"has its summary cut short: all {self.messages} messages were read "
+                "(was the recorder killed as it closed the file?)" if data_ended else
+                f"ends early ({_what(e)}): its last chunk is lost, {self.messages} messages "
+                "before it were read (was the recorder killed?)")
 
 
 def _read_file(path: str, into: list[Message]) -> str:
-    """Append the file's messages to `into`; the problem met, if any ("" when none)."""
+    """Append the file's messages to `into`; what was lost, if anything ("" when nothing),
+    with the command that makes the file whole for readers that need its summary."""
     schemas: dict[int, Schema] = {}
     channels: dict[int, Channel] = {}
-    count = 0
-    try:
-        with open(path, "rb") as f:
-            if f.read(len(MAGIC)) != MAGIC:
-                raise BadRecording(f"{path}: not an MCAP recording (it does not start as one)")
-            f.seek(0)
-            records = StreamReader(f, record_size_limit=1 << 30).records
-            for record in records:
-                if isinstance(record, Schema):
-                    schemas[record.id] = record
-                elif isinstance(record, McapChannel):
-                    channels[record.id] = _channel(record, schemas.get(record.schema_id))
-                elif isinstance(record, McapMessage):
-                    channel = channels.get(record.channel_id)
-                    if channel is not None:
-                        into.append(Message(channel, record.log_time, record.publish_time,
-                                            bytes(record.data)))
-                        count += 1
-    except OSError as e:
-        raise BadRecording(f"{path}: cannot be read: {e.strerror or e}") from None
-    except _DAMAGE as e:
-        if not schemas and not channels and not count:
-            raise BadRecording(f"{path}: an MCAP file without a complete chunk ({_what(e)}: "
-                               "was its recorder killed as it started?)") from None
-        return (f"{path} ends early ({_what(e)}): its last chunk is lost, {count} messages "
-                "before it were read (was the recorder killed?)")
-    return ""
+    records = FileRecords(path)
+    for record in records:
+        if isinstance(record, Schema):
+            schemas[record.id] = record
+        elif isinstance(record, McapChannel):
+            channels[record.id] = channel_of(record, schemas.get(record.schema_id))
+        elif isinstance(record, McapMessage):
+            channel = channels.get(record.channel_id)
+            if channel is not None:
+                into.append(Message(channel, record.log_time, record.publish_time,
+                                    bytes(record.data)))
+    if not records.problem:
+        return ""
+    return (f"{path} {records.problem}; `{REINDEX_COMMAND} {shlex.quote(path)}` rewrites it whole "
+            "(summary, indexes, footer) for readers that need them (rosbags, ros2 bag)")
 
 
 def _what(error: Exception) -> str:
-    text = str(error) or type(error).__name__
-    return {"EndOfFile": "the file is cut short"}.get(type(error).__name__, text)
+    if isinstance(error, (EndOfFile, struct.error)):     # a record or a field ends too soon
+        return "the file is cut short"
+    return str(error) or type(error).__name__
 
 
-def _channel(record: McapChannel, schema: Schema | None) -> Channel:
+def channel_of(record: McapChannel, schema: Schema | None) -> Channel:
     try:
         qos = tuple(yaml.safe_load(record.metadata.get("offered_qos_profiles", "")) or ())
     except yaml.YAMLError:

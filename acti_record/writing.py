@@ -11,6 +11,7 @@ flushes the one in progress every FLUSH_PERIOD_S: a process killed with -9 leave
 (`acti_record.reading`)."""
 from __future__ import annotations
 
+import fcntl
 import os
 from dataclasses import dataclass, field
 from typing import Any
@@ -59,11 +60,24 @@ def dump_yaml(value: Any) -> str:
     return yaml.safe_dump(value, sort_keys=False, default_flow_style=False)
 
 
+class RecordedElsewhere(OSError):
+    """The file is being written by another process (a recorder holds its lock)."""
+
+
 class _WriteThrough:
-    """The file under the MCAP writer, unbuffered: a finished chunk is in the file at once."""
+    """The file under the MCAP writer, unbuffered: a finished chunk is in the file at once. The
+    file is locked (flock, exclusive) while it is written, so that no reindex rewrites it under
+    a running recorder; a process killed with -9 leaves no lock behind."""
 
     def __init__(self, path: str) -> None:
-        self._file = open(path, "wb", buffering=0)
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT, 0o666)
+        try:                                  # locked before it is emptied
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(fd)
+            raise RecordedElsewhere(f"{path} is being recorded by another process") from None
+        os.ftruncate(fd, 0)
+        self._file = open(fd, "wb", buffering=0)
 
     def write(self, data: bytes) -> int:
         view = memoryview(data)
@@ -77,8 +91,21 @@ class _WriteThrough:
     def flush(self) -> None:
         pass
 
+    def sync(self) -> None:
+        os.fsync(self._file.fileno())
+
     def close(self) -> None:
         self._file.close()
+
+
+def check_not_written(path: str) -> None:
+    """Raise RecordedElsewhere when a process is writing `path` (holds its lock)."""
+    with open(path, "rb") as f:
+        try:
+            fcntl.flock(f, fcntl.LOCK_SH | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise RecordedElsewhere(f"{path} is being recorded (a recorder holds it): end the "
+                                    "recorder first") from None
 
 
 @dataclass
@@ -97,39 +124,62 @@ class _Counts:
 
 
 class McapFile:
-    """One MCAP file of a recording."""
+    """One MCAP file of a recording. `name`: the file's name in its rosbag2 metadata (its own
+    by default; a file written under a temporary name gives the name it will have)."""
 
-    def __init__(self, path: str, compression: str = "none", chunk_bytes: int = CHUNK_BYTES) -> None:
+    def __init__(self, path: str, compression: str = "none", chunk_bytes: int = CHUNK_BYTES,
+                 name: str = "", library: str = LIBRARY) -> None:
         if compression not in COMPRESSIONS:
             raise ValueError(f"compression {compression!r}: use one of {', '.join(COMPRESSIONS)}")
-        self.path = path
+        self.path, self.name = path, name or os.path.basename(path)
         self._stream = _WriteThrough(path)
         self._writer = Writer(self._stream, chunk_size=chunk_bytes,
                               compression=COMPRESSIONS[compression], enable_crcs=True)
-        self._writer.start(profile=PROFILE, library=LIBRARY)
-        self._schemas: dict[str, int] = {}
+        self._writer.start(profile=PROFILE, library=library)
+        self._schemas: dict[tuple[str, str, str], int] = {}
         self._channels: dict[str, tuple[int, Topic]] = {}
         self.counts = _Counts()
 
     def channel(self, topic: Topic) -> int:
-        """The channel id of `topic`, registered (with its schema) on first use."""
+        """The channel id of `topic`, registered (with its schema) on first use, with rosbag2's
+        channel metadata."""
         known = self._channels.get(topic.name)
         if known is not None:
             return known[0]
-        schema = self._schemas.get(topic.type)
+        return self.register(topic, SCHEMA_ENCODING if topic.definition else "",
+                             MESSAGE_ENCODING,
+                             {"offered_qos_profiles": dump_yaml(list(topic.qos_profiles)),
+                              "topic_type_hash": topic.type_hash})
+
+    def register(self, topic: Topic, schema_encoding: str, message_encoding: str,
+                 metadata: dict[str, str]) -> int:
+        """A new channel for `topic` with the encodings and metadata given (a reindexed file
+        keeps its own), and its schema unless an equal one is registered; its id."""
+        key = (topic.type, schema_encoding, topic.definition)
+        schema = self._schemas.get(key)
         if schema is None:
-            encoding = SCHEMA_ENCODING if topic.definition else ""
-            schema = self._schemas[topic.type] = self._writer.register_schema(
-                topic.type, encoding, topic.definition.encode())
-        metadata = {"offered_qos_profiles": dump_yaml(list(topic.qos_profiles)),
-                    "topic_type_hash": topic.type_hash}
-        channel = self._writer.register_channel(topic.name, MESSAGE_ENCODING, schema, metadata)
+            schema = self._schemas[key] = self._writer.register_schema(
+                topic.type, schema_encoding, topic.definition.encode())
+        channel = self._writer.register_channel(topic.name, message_encoding, schema, metadata)
         self._channels[topic.name] = (channel, topic)
         return channel
 
     def write(self, topic: Topic, data: bytes, log_ns: int, publish_ns: int) -> None:
-        self._writer.add_message(self.channel(topic), log_ns, data, publish_ns)
-        self.counts.add(topic.name, log_ns)
+        self.write_to(self.channel(topic), topic.name, data, log_ns, publish_ns)
+
+    def write_to(self, channel: int, topic: str, data: bytes, log_ns: int, publish_ns: int,
+                 sequence: int = 0) -> None:
+        """A message on a registered channel."""
+        self._writer.add_message(channel, log_ns, data, publish_ns, sequence)
+        self.counts.add(topic, log_ns)
+
+    def add_metadata(self, name: str, data: dict[str, str]) -> None:
+        """A metadata record other than rosbag2's (which `close` writes)."""
+        self._writer.add_metadata(name, data)
+
+    def add_attachment(self, create_ns: int, log_ns: int, name: str, media_type: str,
+                       data: bytes) -> None:
+        self._writer.add_attachment(create_ns, log_ns, name, media_type, data)
 
     def flush(self) -> None:
         """Write the chunk in progress to the file (the recorder does every FLUSH_PERIOD_S)."""
@@ -139,15 +189,18 @@ class McapFile:
     def size(self) -> int:
         return self._stream.tell()
 
-    def close(self) -> None:
-        """The rosbag2 metadata record, then MCAP's summary and footer."""
+    def close(self, sync: bool = False) -> None:
+        """The rosbag2 metadata record, then MCAP's summary and footer; with `sync`, on the
+        disk before this returns."""
         self._writer.add_metadata("rosbag2", {"serialized_metadata": dump_yaml(self._metadata())})
         self._writer.finish()
+        if sync:
+            self._stream.sync()
         self._stream.close()
 
     def _metadata(self) -> dict:
         """rosbag2's BagMetadata of this file alone."""
-        c, name = self.counts, os.path.basename(self.path)
+        c, name = self.counts, self.name
         start, duration = {"nanoseconds_since_epoch": c.first_ns}, {"nanoseconds": c.last_ns - c.first_ns}
         return {
             "version": METADATA_VERSION, "storage_identifier": "mcap",

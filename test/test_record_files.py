@@ -1,11 +1,17 @@
 """The ROS-free recording core: files as rosbag2 writes them (read back by rosbags and by the
-mcap library's own indexed reader), split files, files cut short by a kill, files that are not
-recordings at all."""
+mcap library's own indexed reader), split files, files cut short by a kill and reindexed whole,
+files that are not recordings at all."""
 import os
 import shutil
+import subprocess
+import sys
+
+from pathlib import Path
 
 import pytest
 from mcap.reader import make_reader
+from mcap.records import Footer
+from mcap.stream_reader import StreamReader
 from rclpy.serialization import serialize_message
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
@@ -13,8 +19,11 @@ from std_msgs.msg import String
 
 from acti_bringup.recording.types import share_dir
 from acti_record.definitions import SEPARATOR, full_text
-from acti_record.reading import BadRecording, read_recording
-from acti_record.writing import McapFile, Recording, Topic, qos_profile
+from acti_record.reading import REINDEX_COMMAND, BadRecording, read_recording
+from acti_record.reindexing import reindex_file
+from acti_record.writing import McapFile, RecordedElsewhere, Recording, Topic, qos_profile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 INFINITE_NS = 9223372036854775807
 RELIABLE = qos_profile("keep_last", 10, "reliable", "volatile", INFINITE_NS, INFINITE_NS,
@@ -102,6 +111,7 @@ def test_a_file_cut_short_gives_its_complete_chunks_and_says_what_was_lost(tmp_p
         dst.write(src.read(size // 2))
     contents = read_recording(cut)
     assert "ends early" in contents.problem and "last chunk is lost" in contents.problem
+    assert f"{REINDEX_COMMAND} {cut}` rewrites it whole" in contents.problem
     read = [m.data for m in contents.messages]
     assert len(read) > 1000 and read == data[:len(read)]
 
@@ -123,3 +133,181 @@ def test_what_is_not_a_recording_is_refused_in_one_line(tmp_path, content, says)
 def test_a_missing_recording_is_refused_in_one_line(tmp_path):
     with pytest.raises(BadRecording, match="no such recording"):
         read_recording(str(tmp_path / "none.mcap"))
+
+
+def whole_file(path: str, count: int = 3000, compression: str = "none") -> list[bytes]:
+    """A complete file of `count` strings in many small chunks, log time i, sequence i."""
+    data = strings(count, size=200)
+    file = McapFile(path, compression, chunk_bytes=20_000)
+    channel = file.channel(STRING)
+    for i, d in enumerate(data):
+        file.write_to(channel, STRING.name, d, 1_000 + i, 2_000 + i, sequence=i)
+    file.close()
+    return data
+
+
+def cut_copy(whole: str, to: str, size: int) -> str:
+    with open(whole, "rb") as src, open(to, "wb") as dst:
+        dst.write(src.read(size))
+    return to
+
+
+def kept_before(summary, cut: int) -> int:
+    """How many messages are in the chunks that end before `cut` (log times 1000, 1001 …)."""
+    ends = [c.message_end_time for c in summary.chunk_indexes
+            if c.chunk_start_offset + c.chunk_length <= cut]
+    return max(ends) - 1_000 + 1 if ends else 0
+
+
+def opened_by_its_summary(path: str):
+    """What readers that need the summary read: mcap's indexed reader (summary, messages,
+    the rosbag2 record) and rosbags' AnyReader (the strings)."""
+    with open(path, "rb") as f:
+        reader = make_reader(f)
+        summary = reader.get_summary()
+        assert summary is not None
+        messages = [(m.log_time, m.publish_time, m.sequence, m.data)
+                    for _, _, m in reader.iter_messages(log_time_order=False)]
+        (bag,) = [m for m in reader.iter_metadata() if m.name == "rosbag2"]
+    with AnyReader([Path(path)], default_typestore=get_typestore(Stores.ROS2_JAZZY)) as rosbag:
+        texts = [rosbag.deserialize(raw, c.msgtype).data for c, _, raw in rosbag.messages()]
+    return summary, messages, bag.metadata["serialized_metadata"], texts
+
+
+def test_a_file_cut_short_is_refused_by_readers_that_need_its_summary(tmp_path):
+    whole = str(tmp_path / "whole.mcap")
+    whole_file(whole)
+    cut = cut_copy(whole, str(tmp_path / "cut.mcap"), os.path.getsize(whole) // 2)
+    with pytest.raises(Exception, match="magic"):
+        with AnyReader([Path(cut)], default_typestore=get_typestore(Stores.ROS2_JAZZY)):
+            pass
+    with open(cut, "rb") as f, pytest.raises(Exception):
+        make_reader(f).get_summary()
+
+
+def cut_offsets(whole: str) -> dict[str, int]:
+    """Where a kill can cut a file: mid-chunk (many), at a chunk's end, between a chunk and
+    its message indexes, at the data section's end, mid-summary, in the footer and magic."""
+    with open(whole, "rb") as f:
+        summary = make_reader(f).get_summary()
+        f.seek(0)
+        (footer,) = [r for r in StreamReader(f).records if isinstance(r, Footer)]
+    summary_start = footer.summary_start
+    chunks = summary.chunk_indexes
+    first = chunks[0]
+    size = os.path.getsize(whole)
+    offsets = {f"mid-chunk {i}": c.chunk_start_offset + c.chunk_length // 3
+               for i, c in enumerate(chunks) if i % 7 == 1}
+    offsets.update({
+        "the first chunk's end": first.chunk_start_offset + first.chunk_length,
+        "in the first chunk's message index": first.chunk_start_offset + first.chunk_length + 5,
+        "after the last chunk's indexes": chunks[-1].chunk_start_offset + chunks[-1].chunk_length
+        + chunks[-1].message_index_length,
+        "the data section's end": summary_start,
+        "mid-summary": (summary_start + size) // 2,
+        "in the footer": size - 15,
+        "in the closing magic": size - 3})
+    return offsets
+
+
+@pytest.mark.parametrize("compression", ["none", "zstd"])
+def test_a_file_cut_anywhere_is_reindexed_whole_and_opens_with_rosbags_and_mcap(tmp_path,
+                                                                               compression):
+    whole = str(tmp_path / "whole.mcap")
+    data = whole_file(whole, compression=compression)
+    with open(whole, "rb") as f:
+        original = make_reader(f).get_summary()
+    (channel,) = original.channels.values()
+    for where, offset in cut_offsets(whole).items():
+        cut = cut_copy(whole, str(tmp_path / "cut.mcap"), offset)
+        done = reindex_file(cut)
+        kept = min(kept_before(original, offset), len(data))
+        assert done.messages == kept and done.lost, where
+        summary, messages, bag, texts = opened_by_its_summary(cut)
+        assert messages == [(1_000 + i, 2_000 + i, i, data[i]) for i in range(kept)], where
+        assert texts == [f"{i:06d}" + "x" * 200 for i in range(kept)], where
+        assert summary.statistics.message_count == kept, where
+        assert f"message_count: {kept}\n" in bag and "relative_file_paths:\n- cut.mcap" in bag
+        (again,) = summary.channels.values()
+        assert (again.topic, again.metadata) == (channel.topic, channel.metadata), where
+        (schema,) = summary.schemas.values()
+        assert (schema.name, schema.encoding, schema.data) == (
+            "std_msgs/msg/String", "ros2msg", original.schemas[channel.schema_id].data)
+        assert {c.compression for c in summary.chunk_indexes} == {
+            "" if compression == "none" else compression}, where
+        assert not read_recording(cut).problem
+        assert not [p for p in os.listdir(tmp_path) if p.endswith(".reindexing")]
+
+
+def test_a_complete_file_is_left_alone(tmp_path):
+    whole = str(tmp_path / "whole.mcap")
+    whole_file(whole, count=100)
+    before = (open(whole, "rb").read(), os.stat(whole).st_mtime_ns)
+    done = reindex_file(whole)
+    assert (done.messages, done.lost) == (100, "") and "already complete" in done.text
+    assert (open(whole, "rb").read(), os.stat(whole).st_mtime_ns) == before
+
+
+def test_a_file_being_recorded_is_not_reindexed(tmp_path):
+    path = str(tmp_path / "live.mcap")
+    recording = Recording(path)
+    write(recording, strings(10))
+    recording.flush()
+    with pytest.raises(RecordedElsewhere, match="being recorded"):
+        reindex_file(path)
+    with pytest.raises(RecordedElsewhere, match="being recorded"):
+        Recording(path)                  # nor emptied by a second recorder
+    recording.close()
+    assert len(read_recording(path).messages) == 10
+
+
+def reindex(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "acti_bringup.reindex", *args], cwd=ROOT,
+                          capture_output=True, text=True, timeout=120)
+
+
+def test_the_command_reindexes_the_split_files_of_a_stem_cut_short(tmp_path):
+    stem = str(tmp_path / "s.mcap")
+    recording = Recording(stem, max_bytes=300_000)
+    data = strings(400, size=2000)
+    for i, d in enumerate(data):
+        write(recording, [d], t0=1_000_000_000 + i)
+        if i % 50 == 0:
+            recording.flush()
+    recording.flush()                    # killed here: the last file has no summary
+    last = recording.paths[-1]
+    shutil.copy(last, str(tmp_path / "cut"))
+    recording.close()
+    os.replace(str(tmp_path / "cut"), last)
+    done = reindex(stem)
+    assert done.returncode == 0 and done.stderr == "", done
+    lines = done.stdout.splitlines()
+    assert len(lines) == len(recording.paths) and lines[-1].startswith(f"reindexed {last} (")
+    assert all("already complete" in line for line in lines[:-1]), lines
+    texts = []
+    for path in recording.paths:
+        texts += opened_by_its_summary(path)[3]
+    assert [serialize_message(String(data=t)) for t in texts] == data
+
+
+@pytest.mark.parametrize("content, says", [
+    (b"not a recording at all, just text\n" * 10, "not an MCAP recording"),
+    (b"", "not an MCAP recording"),
+    (None, "without a complete chunk"),               # cut just after its header
+])
+def test_what_cannot_be_reindexed_is_refused_in_one_line(tmp_path, content, says):
+    bad = tmp_path / "bad.mcap"
+    if content is None:
+        whole = str(tmp_path / "whole.mcap")
+        whole_file(whole, count=10)
+        with open(whole, "rb") as f:
+            header_end = make_reader(f).get_summary().chunk_indexes[0].chunk_start_offset
+        cut_copy(whole, str(bad), header_end)
+    else:
+        bad.write_bytes(content)
+    before = bad.read_bytes()
+    refused = reindex(str(bad))
+    assert refused.returncode == 2 and refused.stdout == "", refused
+    assert refused.stderr.count("\n") == 1 and says in refused.stderr, refused.stderr
+    assert "Traceback" not in refused.stderr and bad.read_bytes() == before
+    assert not [p for p in os.listdir(tmp_path) if p.endswith(".reindexing")]
