@@ -10,6 +10,9 @@ import sys
 import time
 from typing import Any, Callable
 
+from acti_msgs import srv
+from acti_msgs.msg import VehiclePoint, VehicleVelocity
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SERVICE_TIMEOUT = 30.0
 CALL_TIMEOUT = 30.0
@@ -203,3 +206,41 @@ class OneShotClients:
 
 
 FELL_BEHIND = r"fell (\d+) ms behind"    # the control loop's report (MotionExecutor), in ms
+
+
+# both devices kept moving, for the recording's tests and benches: slow motions, so that a
+# queue lasts even as fast as the job can (25x)
+ARM, BASE = "/acti_middle_node/", "/vehicle_node/"
+POSES = ([30.0, 40.0, 20.0, -70.0, 20.0, 50.0, 10.0], [-30.0, 20.0, -20.0, -50.0, -20.0, 70.0, -10.0])
+SQUARE = ((1000.0, 0.0), (1000.0, 1000.0), (0.0, 1000.0), (0.0, 0.0))   # mm
+BASE_MOVING = 0x011                     # the base's state code while it moves
+
+
+def start_moving(ros: RosClient) -> None:
+    """Both devices powered and slow: the arm at 5 % joint speed, the base at 100 mm/s."""
+    ros.call(srv.ServoON, ARM + "servo_on")
+    ros.call(srv.SetSpeedJoint, ARM + "set_speed_joint", spd_ratio=5)
+    ros.call(srv.VehicleSetPower, BASE + "set_power", on_off=True)
+    ros.call(srv.VehicleSetServo, BASE + "set_servo", on_off=True)
+    ros.call(srv.VehicleSetVelocity, BASE + "set_velocity",
+             vel=VehicleVelocity(translation=100.0, rotation=5.0))
+
+
+def keep_moving(ros: RosClient, motions: int) -> None:
+    """`motions` queued on each device: the arm between two poses, the base round a square."""
+    for i in range(motions):
+        ros.call(srv.MovePTPJointAbs, ARM + "move_ptp_joint_abs", joint_points=POSES[i % 2])
+        x, y = SQUARE[i % len(SQUARE)]
+        reply = ros.call(srv.VehicleMoveCruiseAbs, BASE + "move_cruise_abs",
+                         cruise_point=VehiclePoint(x=x, y=y))
+        assert reply.success, reply.message
+
+
+def both_moving(ros: RosClient) -> bool:
+    return bool(ros.call(srv.GetState, ARM + "get_state").state & 0x2) and \
+        ros.call(srv.VehicleGetState, BASE + "get_state").state == BASE_MOVING
+
+
+def stop_moving(ros: RosClient) -> None:
+    ros.call(srv.Stop, ARM + "stop")
+    ros.call(srv.VehicleStop, BASE + "stop")

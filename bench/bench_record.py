@@ -17,43 +17,14 @@ import time
 
 import numpy as np
 from acti_msgs import srv
-from acti_msgs.msg import VehiclePoint, VehicleVelocity
 from bench_ros_graph import measure
 from common import NodeProcess, RosClient, cpu_seconds, paired, running, row
 
-from acti_bringup.harness import ROOT
+from acti_bringup.harness import (ARM, ROOT, both_moving, keep_moving, start_moving,
+                                  stop_moving)
 
 WINDOWS = 4                      # of each kind, interleaved
-POSES = ([30.0, 40.0, 20.0, -70.0, 20.0, 50.0, 10.0], [-30.0, 20.0, -20.0, -50.0, -20.0, 70.0, -10.0])
-ARM, BASE = "/acti_middle_node/", "/vehicle_node/"
 QUEUED = 24                      # motions per device queued for each window
-BUSY = 0x011                     # the base's state code while it moves
-SQUARE = ((1000.0, 0.0), (1000.0, 1000.0), (0.0, 1000.0), (0.0, 0.0))   # mm
-
-
-def start_moving(ros: RosClient) -> None:
-    """Slow motions, so that a window's queue lasts even as fast as the job can (25x)."""
-    ros.call(srv.ServoON, ARM + "servo_on")
-    ros.call(srv.SetSpeedJoint, ARM + "set_speed_joint", spd_ratio=5)
-    ros.call(srv.VehicleSetPower, BASE + "set_power", on_off=True)
-    ros.call(srv.VehicleSetServo, BASE + "set_servo", on_off=True)
-    ros.call(srv.VehicleSetVelocity, BASE + "set_velocity",
-             vel=VehicleVelocity(translation=100.0, rotation=5.0))
-
-
-def keep_moving(ros: RosClient) -> None:
-    """Both queues refilled: the arm between two poses, the base cruising round a square."""
-    for i in range(QUEUED):
-        ros.call(srv.MovePTPJointAbs, ARM + "move_ptp_joint_abs", joint_points=POSES[i % 2])
-        x, y = SQUARE[i % len(SQUARE)]
-        reply = ros.call(srv.VehicleMoveCruiseAbs, BASE + "move_cruise_abs",
-                         cruise_point=VehiclePoint(x=x, y=y))
-        assert reply.success, reply.message
-
-
-def stop_moving(ros: RosClient) -> None:
-    ros.call(srv.Stop, ARM + "stop")
-    ros.call(srv.VehicleStop, BASE + "stop")
 
 
 def windows(ros: RosClient, job_pid: int, folder: str) -> dict[str, list[tuple]]:
@@ -71,7 +42,7 @@ def windows(ros: RosClient, job_pid: int, folder: str) -> dict[str, list[tuple]]
                     and time.monotonic() < deadline:
                 time.sleep(0.1)               # subscribed to everything and writing
         stop_moving(ros)
-        keep_moving(ros)
+        keep_moving(ros, QUEUED)
         if recorder is not None:
             r0, s0 = cpu_seconds(recorder.pid), os.path.getsize(path)
         t0 = time.monotonic()
@@ -83,8 +54,7 @@ def windows(ros: RosClient, job_pid: int, folder: str) -> dict[str, list[tuple]]
             rate = (os.path.getsize(path) - s0) / seconds
             recorder.send_signal(signal.SIGINT)
             recorder.wait(timeout=30)
-        moving = bool(ros.call(srv.GetState, ARM + "get_state").state & 0x2) and \
-            ros.call(srv.VehicleGetState, BASE + "get_state").state == BUSY
+        moving = both_moving(ros)
         out["recorded" if recorded else "not recorded"].append((rtf, cpu, rec_cpu, rate, moving))
     stop_moving(ros)
     return out

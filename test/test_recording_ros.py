@@ -1,7 +1,8 @@
 """Recording and replaying the job over DDS: the quick tour's calls recorded by the job's own
 `record` parameter and replayed against a fresh job with every answer equal; topics read back
 with rosbags as they were published and republished with their timing; a recorder killed with
--9 leaves a readable file; what is not a recording is refused in one line."""
+-9 while both devices move leaves a file that reads up to its last flush and is reindexed
+whole for rosbags; what is not a recording is refused in one line."""
 import os
 import signal
 import subprocess
@@ -9,12 +10,14 @@ import sys
 
 import pytest
 from mcap.reader import make_reader
+from rclpy.serialization import deserialize_message
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
 from std_msgs.msg import String
 
-from acti_bringup.harness import ROOT, Actions, NodeProcess, wait_until
+from acti_bringup.harness import (ROOT, Actions, NodeProcess, both_moving, keep_moving,
+                                  start_moving, wait_until)
 from acti_msgs import srv
 from acti_msgs.action import Move, RunProgram, VehicleWaitMotion, WaitMotion
 from acti_msgs.msg import CarPosWithElbow, VehiclePosition
@@ -153,23 +156,58 @@ def _flushed(path: str):
 
 
 
-def test_a_recorder_killed_with_9_leaves_a_file_that_reads_up_to_its_last_chunk(ros, tmp_path):
+def test_a_recorder_killed_with_9_while_both_devices_move_leaves_a_file_reindexed_whole(
+        ros, tmp_path):
+    """What the file held when the kill came is all read back, by rosbags once reindexed;
+    what is lost is what came after the recorder's last flush."""
     moving = job(tmp_path, "moving")
     path = str(tmp_path / "killed.mcap")
     rec = recorder(path)                     # every topic: the job's clock, joints, TF …
+    sent = [f"sent before the kill {i}" for i in range(200)]
+    publisher = ros.node.create_publisher(String, "/record_kill_test", LASTING)
     try:
-        assert wait_until(lambda: os.path.exists(path) and os.path.getsize(path) > 1_000_000,
-                          120.0), rec
+        start_moving(ros)
+        keep_moving(ros, 12)
+        for text in sent:
+            publisher.publish(String(data=text))
+        assert wait_until(lambda: os.path.exists(path) and os.path.getsize(path) > 1_000_000
+                          and _texts(_flushed(path)) == sent, 120.0), rec
+        assert both_moving(ros)
+        held = read_recording(path).messages  # the file as the kill finds it, at least
     finally:
         rec.kill()
         rec.wait()
+        ros.node.destroy_publisher(publisher)
         moving.stop()
     contents = read_recording(path)
-    assert "ends early" in contents.problem
-    topics = {c.topic for c in contents.channels}
-    assert {"/clock", "/joint_states", "/tf"} <= topics and len(contents.messages) > 1000
+    assert "ends early" in contents.problem and "acti_bringup.reindex" in contents.problem
+    assert [m.data for m in contents.messages[:len(held)]] == [m.data for m in held]
     shown = run("acti_bringup.replay", path, "--topics", "/none")   # reads it, says what is lost
     assert shown.returncode == 0 and "ends early" in shown.stderr, shown.stdout + shown.stderr
+
+    reindexed = run("acti_bringup.reindex", path)
+    assert reindexed.returncode == 0 and reindexed.stdout.startswith(f"reindexed {path} ("), \
+        reindexed.stdout + reindexed.stderr
+    with AnyReader([tmp_path / "killed.mcap"],
+                   default_typestore=get_typestore(Stores.ROS2_JAZZY)) as bag:
+        read = [(c.topic, raw) for c, _, raw in bag.messages()]
+        joints = [bag.deserialize(raw, c.msgtype) for c, _, raw in bag.messages()
+                  if c.topic == "/joint_states"]
+        texts = [bag.deserialize(raw, c.msgtype).data for c, _, raw in bag.messages()
+                 if c.topic == "/record_kill_test"]
+    assert sorted(raw for _, raw in read) == sorted(m.data for m in contents.messages)
+    assert {"/clock", "/joint_states", "/tf"} <= {topic for topic, _ in read}
+    assert texts == sent
+    first, last = joints[0], joints[-1]    # the joints moved while it recorded
+    assert [round(p, 3) for p in first.position] != [round(p, 3) for p in last.position]
+    with open(path, "rb") as f:
+        assert make_reader(f).get_summary().statistics.message_count == len(contents.messages)
+    assert run("acti_bringup.reindex", path).stdout.endswith("left alone\n")
+
+
+def _texts(messages) -> list[str]:
+    return [deserialize_message(m.data, String).data for m in messages
+            if m.channel.topic == "/record_kill_test"]
 
 
 @pytest.mark.parametrize("content", [b"", b"plain text, not a recording\n", b"\x89MCAP0\r\n\x01"])
