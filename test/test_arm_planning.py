@@ -12,8 +12,10 @@ from scipy.interpolate import CubicSpline
 from acti_motion.arm.core import ArmConfig, ArmCore, shared_kinematics
 from acti_motion.arm.poses import Frames, pose_to_hg
 from acti_motion.arm.trajectories import (TOPPRA_GRID, ArcPath, CartesianLimits, CartesianPlanner,
-                                          LinePath, not_a_knot_spline, poses_along,
-                                          positions_along, time_optimal, toppra_grid)
+                                          LinePath, bounds_keep_limits, keeps_limits,
+                                          not_a_knot_spline, poses_along, positions_along,
+                                          samples_keep_limits, time_optimal, toppra_grid)
+from acti_motion.profiles import Trapezoid
 from acti_motion.replies import ReturnCode as R
 from sim_fixtures import executor  # noqa: F401
 
@@ -158,3 +160,34 @@ def test_the_joint_spline_is_scipy_s_not_a_knot_cubic_spline(n):
 
 def test_toppra_is_imported_with_the_planner():
     assert "toppra" in sys.modules            # at start-up, never inside the first request
+
+
+def _plans_and_profiles(kin):
+    """CP plans of a table of paths (short and long lines, turns, an arc, near the wrist
+    singularity) under nominal profiles from slow to fast, with short and long ramps."""
+    P0 = kin.flange(WORK)
+    paths = [LinePath(P0, moved(P0, (0.02, 0.0, 0.0))), LinePath(P0, moved(P0, (0.0, 0.2, 0.0))),
+             LinePath(P0, moved(P0, (0.1, 0.15, -0.1), (0.0, 0.0, 30.0))),
+             ArcPath(P0, P0[:3, 3] + [0.1, 0.1, 0.0], moved(P0, (0.2, 0.0, 0.0)))]
+    plans = [CartesianPlanner(kin).plan(p, Frames(), WORK, limits(kin)) for p in paths]
+    plans.append(CartesianPlanner(kin).plan(LinePath(kin.flange(SINGULAR_FROM),
+                                                     kin.flange(SINGULAR_TO)),
+                                            Frames(), SINGULAR_FROM, limits(kin)))
+    for plan in plans:
+        for duration in (0.05, 0.2, 0.5, 1.0, 3.0, 20.0):
+            for ramp in (0.01, 0.1, 0.3):
+                yield plan.path, Trapezoid(max(duration, 2 * ramp), ramp)
+
+
+def test_the_limits_bound_says_keeps_only_where_every_sample_keeps(kin):
+    """`keeps_limits` decides as the 401 samples do, on a table of plans and profiles; its
+    bounds decide alone in part of them (the short lines), never against the samples."""
+    lim, by_bound, answers = limits(kin), 0, set()
+    for spline, nominal in _plans_and_profiles(kin):
+        sampled = samples_keep_limits(spline, nominal, lim)
+        assert keeps_limits(spline, nominal, lim) == sampled
+        if bounds_keep_limits(spline.spline, nominal, lim):
+            assert sampled
+            by_bound += 1
+        answers.add(sampled)
+    assert answers == {True, False} and by_bound > 10

@@ -51,6 +51,7 @@ GRID_STEP_MM = 15.0       # TOPP-RA grid intervals: at most this much of the pat
 GRID_STEP_RAD = math.radians(3.0)   # and of a turn or of the joints' travel
 SAMPLE_FLOOR = 4          # least intervals of the IK samples of a CP path (more where it strays)
 ELBOW_GRID_FLOOR = 4      # least intervals of the grid the elbow is carried on along a CP path
+NO_TURN = 1e-12           # rad: a line's rotation below this is rounding (R1·R0ᵀ of equal R)
 
 
 @dataclass(frozen=True)
@@ -216,7 +217,8 @@ class LinePath:
         """Poses at each s (N×4×4)."""
         ss = np.asarray(ss, float)
         T = np.zeros((len(ss), 4, 4))
-        T[:, :3, :3] = exp3_many(ss[:, None] * self.w) @ self.R0 if self.angle else self.R0
+        turns = self.angle > NO_TURN
+        T[:, :3, :3] = exp3_many(ss[:, None] * self.w) @ self.R0 if turns else self.R0
         T[:, :3, 3] = self.positions(ss)
         T[:, 3, 3] = 1.0
         return T
@@ -324,7 +326,7 @@ class CartesianPlanner:
         extents = np.array([path.length, path.angle, abs(turn)])
         speeds = np.array([limits.speed, limits.angular_speed, limits.angular_speed])
         nominal = Trapezoid.for_axes(extents, speeds, limits.ramp)
-        if self._keeps_limits(spline, nominal, limits):
+        if keeps_limits(spline, nominal, limits):
             return CartesianPlan(spline, nominal, False)
         timing = time_optimal(spline.ss, spline.qs, extents, limits)
         return CartesianPlan(spline, timing, True)
@@ -392,17 +394,41 @@ class CartesianPlanner:
             ss, qs = _insert(ss, qs, todo, ik.between)
         return SplineJointPath(ss, qs)
 
-    @staticmethod
-    def _keeps_limits(spline: SplineJointPath, nominal: Trapezoid,
-                      limits: CartesianLimits) -> bool:
-        if nominal.duration <= 0.0:
-            return True
-        s, sd, sdd = nominal.sample_many(np.linspace(0.0, nominal.duration, 401))
-        d1, d2 = spline.d1(s), spline.d2(s)
-        qd = d1 * sd[:, None]
-        qdd = d2 * (sd ** 2)[:, None] + d1 * sdd[:, None]
-        return bool(np.all(np.abs(qd) <= limits.joint_velocity * (1 + 1e-6))
-                    and np.all(np.abs(qdd) <= limits.joint_accel * (1 + 1e-3)))
+
+def keeps_limits(spline: SplineJointPath, nominal: Trapezoid, limits: CartesianLimits) -> bool:
+    """Whether the joints keep their velocity and acceleration limits along `spline` timed by
+    the nominal profile: at 401 instants (`samples_keep_limits`), decided at once where bounds
+    over the whole path already say so (`bounds_keep_limits`, a short CP line's usual case)."""
+    return (nominal.duration <= 0.0 or bounds_keep_limits(spline.spline, nominal, limits)
+            or samples_keep_limits(spline, nominal, limits))
+
+
+def samples_keep_limits(spline: SplineJointPath, nominal: Trapezoid,
+                        limits: CartesianLimits) -> bool:
+    """The joints' velocity and acceleration at 401 instants of the profile within the limits."""
+    s, sd, sdd = nominal.sample_many(np.linspace(0.0, nominal.duration, 401))
+    d1, d2 = spline.d1(s), spline.d2(s)
+    qd = d1 * sd[:, None]
+    qdd = d2 * (sd ** 2)[:, None] + d1 * sdd[:, None]
+    return bool(np.all(np.abs(qd) <= limits.joint_velocity * (1 + 1e-6))
+                and np.all(np.abs(qdd) <= limits.joint_accel * (1 + 1e-3)))
+
+
+def bounds_keep_limits(spline: PPoly, nominal: Trapezoid, limits: CartesianLimits) -> bool:
+    """A sufficient condition for `samples_keep_limits`, in a few numpy calls: with |q'(s)| ≤ M1
+    and |q''(s)| ≤ M2 over the whole cubic spline (bounds per piece: q' is a quadratic, q''
+    linear, on [0, h]), ṡ ≤ the profile's peak v and |s̈| ≤ v / ramp, the joint velocity q'ṡ is
+    within M1·v and the acceleration q''ṡ² + q's̈ within M2·v² + M1·v / ramp. Where these
+    bounds keep the limits, so does every sample the full check would take."""
+    if nominal.ramp <= 0.0:
+        return False
+    c = np.abs(spline.c)                         # (4, pieces, dof): x³, x², x, 1 coefficients
+    h = (spline.x[1:] - spline.x[:-1])[:, None]
+    m1 = (c[2] + h * (2.0 * c[1] + 3.0 * h * c[0])).max(axis=0)
+    m2 = (2.0 * c[1] + 6.0 * h * c[0]).max(axis=0)
+    v = nominal.peak
+    return bool((m1 * v <= limits.joint_velocity).all()
+                and (m2 * v * v + m1 * v / nominal.ramp <= limits.joint_accel).all())
 
 
 @dataclass
