@@ -14,7 +14,8 @@ from acti_motion.arm.poses import Frames, pose_to_hg
 from acti_motion.arm.trajectories import (TOPPRA_GRID, ArcPath, CartesianLimits, CartesianPlanner,
                                           LinePath, bounds_keep_limits, keeps_limits,
                                           not_a_knot_spline, poses_along, positions_along,
-                                          samples_keep_limits, time_optimal, toppra_grid)
+                                          samples_keep_limits, spline_within, time_optimal,
+                                          toppra_grid)
 from acti_motion.profiles import Trapezoid
 from acti_motion.replies import ReturnCode as R
 from sim_fixtures import executor  # noqa: F401
@@ -191,3 +192,18 @@ def test_the_limits_bound_says_keeps_only_where_every_sample_keeps(kin):
             by_bound += 1
         answers.add(sampled)
     assert answers == {True, False} and by_bound > 10
+
+
+def test_the_spline_bound_says_within_only_where_every_point_is(kin):
+    """`spline_within` (the CP path's joint soft-limit check at once) on the table's joint
+    splines against limits around their range sampled finely: never within where a point is
+    outside; within for the short line with room to spare."""
+    splines = {id(s): s for s, _ in _plans_and_profiles(kin)}.values()
+    for spline in splines:
+        fine = spline.spline(np.linspace(0.0, 1.0, 20001))
+        low, high = fine.min(axis=0), fine.max(axis=0)
+        assert not spline_within(spline.spline, low + 1e-9, high + 1.0)
+        assert not spline_within(spline.spline, low - 1.0, high - 1e-9)
+    short = next(iter(splines)).spline
+    fine = short(np.linspace(0.0, 1.0, 20001))
+    assert spline_within(short, fine.min(axis=0) - 1e-3, fine.max(axis=0) + 1e-3)

@@ -17,12 +17,14 @@ from contextlib import contextmanager
 from typing import Callable, Iterator
 
 import numpy as np
+from scipy.interpolate import PPoly
 
 from acti_motion.arm.kinematics import Unreachable, rotate_about
 from acti_motion.arm.poses import Frames, inverse
 from acti_motion.arm.trajectories import (ArmMotion, ArmSetpoint, CartesianLimits,
                                           CartesianPath, CartesianPlanner, LinearJointPath,
-                                          LinePath, convex_checkpoints, positions_along)
+                                          LinePath, convex_checkpoints, positions_along,
+                                          spline_within)
 from acti_motion.profiles import Trapezoid
 from acti_motion.replies import Refused, Reply, ReturnCode, value_error
 
@@ -160,6 +162,21 @@ class MovePlanning:
             raise value_error(f"{label}: the path leaves the joint soft limit: J{j + 1} = "
                               f"{qs_deg[k, j]:.10g}°, limit [{lim[j, 0]:g}, {lim[j, 1]:g}]°")
 
+    def _check_joint_spline(self, spline: PPoly, label: str) -> None:
+        """A CP path's joint spline within the joint soft limits: at once where a bound over
+        each piece keeps it clear of them (as the samples would find), else at 4 samples per
+        IK sample, finer near a limit."""
+        lim = self.soft_limit_joint
+        if spline_within(spline, np.radians(lim[:, 0] + NEAR_LIMIT_DEG),
+                         np.radians(lim[:, 1] - NEAR_LIMIT_DEG)):
+            return
+        dense = np.linspace(0.0, 1.0, 4 * len(spline.x))
+
+        def joints_deg(ss: np.ndarray) -> np.ndarray:
+            return np.degrees(spline(ss))
+        self._check_joint_path(_near_limits_refined(
+            dense, joints_deg(dense), joints_deg, lim[:, 0], lim[:, 1], NEAR_LIMIT_DEG), label)
+
     # === queueing ======================================================================================
     def queue_joint_move(self, goal_of: Callable[[ArmSetpoint], np.ndarray], label: str,
                           speed_ratio: float | None = None, ramp: float | None = None) -> dict:
@@ -263,13 +280,7 @@ class MovePlanning:
                                            turn=goal_turn)
             except Unreachable as e:
                 raise value_error(f"{label}: {e}") from None
-            dense = np.linspace(0.0, 1.0, 4 * len(result.path.ss))
-            lim = self.soft_limit_joint
-
-            def joints_deg(ss: np.ndarray) -> np.ndarray:
-                return np.degrees(result.path.spline(ss))
-            self._check_joint_path(_near_limits_refined(
-                dense, joints_deg(dense), joints_deg, lim[:, 0], lim[:, 1], NEAR_LIMIT_DEG), label)
+            self._check_joint_spline(result.path.spline, label)
             return ArmMotion(result.path, result.timing, start.finger, start.finger, ramp,
                              "cartesian")
         return self._submit(plan, label)

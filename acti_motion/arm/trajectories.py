@@ -51,6 +51,7 @@ GRID_STEP_MM = 15.0       # TOPP-RA grid intervals: at most this much of the pat
 GRID_STEP_RAD = math.radians(3.0)   # and of a turn or of the joints' travel
 SAMPLE_FLOOR = 4          # least intervals of the IK samples of a CP path (more where it strays)
 ELBOW_GRID_FLOOR = 4      # least intervals of the grid the elbow is carried on along a CP path
+DENSE_SPLINE = 16         # splines through up to this many points are solved densely
 NO_TURN = 1e-12           # rad: a line's rotation below this is rounding (R1·R0ᵀ of equal R)
 
 
@@ -85,26 +86,40 @@ class LinearJointPath:
 def not_a_knot_spline(xs: np.ndarray, ys: np.ndarray) -> PPoly:
     """The cubic spline through (xs[i], ys[i]) (ys: N×dof, N ≥ 4) with not-a-knot ends: the
     one scipy's CubicSpline(xs, ys, axis=0) builds, by the same equations, without its input
-    checks (a sixth of a short CP plan)."""
-    dx = np.diff(xs)[:, None]
-    slope = np.diff(ys, axis=0) / dx
+    checks (a sixth of a short CP plan). A few points (a short line) are solved densely:
+    LAPACK's banded solver through scipy costs more than numpy's dense one up to ~16."""
+    dx = xs[1:] - xs[:-1]
+    slope = (ys[1:] - ys[:-1]) / dx[:, None]
+    h = dx.tolist()
     n = len(xs)
     A = np.zeros((3, n))                    # banded: upper, main, lower diagonal
-    A[1, 1:-1] = 2 * (dx[:-1, 0] + dx[1:, 0])
-    A[0, 2:] = dx[:-1, 0]
-    A[2, :-2] = dx[1:, 0]
+    A[1, 1:-1] = 2.0 * (dx[:-1] + dx[1:])
+    A[0, 2:] = dx[:-1]
+    A[2, :-2] = dx[1:]
     b = np.empty_like(ys)
-    b[1:-1] = 3 * (dx[1:] * slope[:-1] + dx[:-1] * slope[1:])
-    d = xs[2] - xs[0]
-    A[1, 0], A[0, 1] = dx[1, 0], d
-    b[0] = ((dx[0] + 2 * d) * dx[1] * slope[0] + dx[0] ** 2 * slope[1]) / d
-    d = xs[-1] - xs[-3]
-    A[1, -1], A[2, -2] = dx[-2, 0], d
-    b[-1] = (dx[-1] ** 2 * slope[-2] + (2 * d + dx[-1]) * dx[-2] * slope[-1]) / d
-    ds = solve_banded((1, 1), A, b, overwrite_ab=True, overwrite_b=True, check_finite=False)
-    t = (ds[:-1] + ds[1:] - 2 * slope) / dx
-    return PPoly.construct_fast(np.stack([t / dx, (slope - ds[:-1]) / dx - t, ds[:-1],
-                                          ys[:-1]]), np.asarray(xs, float))
+    b[1:-1] = 3.0 * (dx[1:, None] * slope[:-1] + dx[:-1, None] * slope[1:])
+    d = h[0] + h[1]
+    A[1, 0], A[0, 1] = h[1], d
+    b[0] = ((h[0] + 2 * d) * h[1] * slope[0] + h[0] ** 2 * slope[1]) / d
+    d = h[-1] + h[-2]
+    A[1, -1], A[2, -2] = h[-2], d
+    b[-1] = (h[-1] ** 2 * slope[-2] + (2 * d + h[-1]) * h[-2] * slope[-1]) / d
+    if n <= DENSE_SPLINE:
+        ds = np.linalg.solve(np.diag(A[1]) + np.diag(A[0, 1:], 1) + np.diag(A[2, :-1], -1), b)
+    else:
+        ds = solve_banded((1, 1), A, b, overwrite_ab=True, overwrite_b=True, check_finite=False)
+    dxc = dx[:, None]
+    t = (ds[:-1] + ds[1:] - 2.0 * slope) / dxc
+    c = np.empty((4, n - 1, ys.shape[1]))
+    c[0] = t / dxc
+    c[1] = (slope - ds[:-1]) / dxc - t
+    c[2] = ds[:-1]
+    c[3] = ys[:-1]
+    return PPoly.construct_fast(c, np.asarray(xs, float))
+
+
+_D1 = np.array([3.0, 2.0, 1.0])[:, None, None]    # a cubic's coefficients → its derivatives
+_D2 = np.array([6.0, 2.0])[:, None, None]
 
 
 class SplineJointPath:
@@ -114,8 +129,9 @@ class SplineJointPath:
         """`spline`: the one through (ss, qs) when the caller built it already."""
         self.ss, self.qs = ss, qs
         self.spline = not_a_knot_spline(ss, qs) if spline is None else spline
-        self.d1 = self.spline.derivative(1)
-        self.d2 = self.spline.derivative(2)
+        c, x = self.spline.c, self.spline.x      # PPoly.derivative's, without its checks
+        self.d1 = PPoly.construct_fast(c[:-1] * _D1, x)
+        self.d2 = PPoly.construct_fast(c[:-2] * _D2, x)
 
     def q(self, s: float) -> np.ndarray:
         return self.spline(s)
@@ -429,6 +445,18 @@ def bounds_keep_limits(spline: PPoly, nominal: Trapezoid, limits: CartesianLimit
     v = nominal.peak
     return bool((m1 * v <= limits.joint_velocity).all()
                 and (m2 * v * v + m1 * v / nominal.ramp <= limits.joint_accel).all())
+
+
+def spline_within(spline: PPoly, lower: np.ndarray, upper: np.ndarray) -> bool:
+    """Whether a cubic spline stays within [lower, upper] (per axis) between its first and last
+    breakpoints, by a bound per piece: q(x) = c₃ + c₂x + x²(c₁ + c₀x) on [0, h] is within
+    h²(|c₁| + h|c₀|) of the chord c₃ + c₂x. A sufficient condition: False says nothing."""
+    c = spline.c
+    h = (spline.x[1:] - spline.x[:-1])[:, None]
+    bend = h * h * (np.abs(c[1]) + h * np.abs(c[0]))
+    end = c[3] + h * c[2]
+    return bool((np.minimum(c[3], end) - bend >= lower).all()
+                and (np.maximum(c[3], end) + bend <= upper).all())
 
 
 @dataclass
