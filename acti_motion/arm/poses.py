@@ -17,6 +17,7 @@ from acti_motion.replies import Refused, ReturnCode, finite_vector
 ROTATION_TOLERANCE = 1e-3
 EXACT_ROTATION = 1e-15      # |RᵀR − I| of a rotation kept as given (one a getter answered)
 _ORIGIN = np.zeros(3)
+_IDENTITY = np.eye(4)
 
 
 def quaternion_xyzw(rotation: np.ndarray) -> np.ndarray:
@@ -104,6 +105,8 @@ class Frames:
         self.tool = np.eye(4) if tool is None else tool
         self.base_hg = pose_to_hg(self.base) if base_hg is None else base_hg   # as set
         self._base_inv, self._tool_inv = inverse(self.base), inverse(self.tool)
+        self._plain = bool(np.array_equal(self.base, _IDENTITY)
+                           and np.array_equal(self.tool, _IDENTITY))
 
     def with_base(self, base: np.ndarray, base_hg: list[float]) -> "Frames":
         """These frames with another base offset, `base_hg` being it as set (getBaseOffset)."""
@@ -114,9 +117,10 @@ class Frames:
         return Frames(self.base, tool, self.base_hg)
 
     def flange_of(self, P: np.ndarray) -> np.ndarray:
-        """Flange pose (arm frame) that puts the control point at P (robot frame)."""
-        return self.base @ P @ self._tool_inv
+        """Flange pose (arm frame) that puts the control point at P (robot frame). Without
+        offsets P itself (a product with identities is exact: a CP plan is spared it)."""
+        return P if self._plain else self.base @ P @ self._tool_inv
 
     def tool_of(self, F: np.ndarray) -> np.ndarray:
-        """Control-point pose (robot frame) of the flange pose F (arm frame)."""
-        return self._base_inv @ F @ self.tool
+        """Control-point pose (robot frame) of the flange pose F (arm frame); F without offsets."""
+        return F if self._plain else self._base_inv @ F @ self.tool
