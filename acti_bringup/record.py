@@ -8,6 +8,7 @@ open (docs/recording.md). Ends on Ctrl-C or SIGTERM with a complete file.
 from __future__ import annotations
 
 import argparse
+import shlex
 import sys
 
 import rclpy
@@ -15,6 +16,7 @@ from rclpy.executors import SingleThreadedExecutor
 
 from acti_bringup.recording.recorder import Recorder
 from acti_bringup.serving.spinning import SpinLoop, catch_signals, init, wait_for_signal
+from acti_record.reading import REINDEX_COMMAND
 from acti_record.writing import COMPRESSIONS, Recording
 
 
@@ -49,6 +51,9 @@ def main(args: list[str] | None = None) -> None:
                               options.compression)
     except (OSError, ValueError) as e:
         sys.exit(f"record: cannot record to {options.path}: {getattr(e, 'strerror', None) or e}")
+    for path, kept in recording.kept:
+        print(f"record: {path} was cut short (its recorder killed): kept as {kept}; "
+              f"`{REINDEX_COMMAND} {shlex.quote(kept)}` makes it whole", file=sys.stderr)
     init([argv[0], *argv[argv.index("--ros-args"):]] if "--ros-args" in argv else argv[:1])
     node = rclpy.create_node("acti_recorder")
     executor = SingleThreadedExecutor()

@@ -16,6 +16,7 @@ from typing import Iterator
 
 import yaml
 from mcap.exceptions import EndOfFile, McapError
+from mcap.reader import make_reader
 from mcap.records import (Channel as McapChannel, Chunk, DataEnd, McapRecord,
                           Message as McapMessage, Schema)
 from mcap.stream_reader import StreamReader, breakup_chunk
@@ -23,6 +24,9 @@ from mcap.stream_reader import StreamReader, breakup_chunk
 
 MAGIC = b"\x89MCAP0\r\n"
 REINDEX_COMMAND = "python -m acti_bringup.reindex"   # rewrites a file cut short whole
+# what a damaged file raises from inside the mcap reader
+READ_ERRORS = (McapError, struct.error, ValueError, UnicodeDecodeError, EOFError, MemoryError)
+RECORD_LIMIT = 1 << 30        # a longer record is damage, not a record
 
 
 class BadRecording(Exception):
@@ -82,6 +86,29 @@ def _split_index(path: str) -> tuple[int, str]:
     return (int(tail) if tail.isdigit() else -1, path)
 
 
+def summary_messages(path: str) -> int | None:
+    """The message count of a complete file (its footer and summary readable), else None."""
+    try:
+        with open(path, "rb") as f:
+            summary = make_reader(f).get_summary()
+    except (OSError, *READ_ERRORS):
+        return None
+    if summary is None:
+        return None
+    return summary.statistics.message_count if summary.statistics else 0
+
+
+def cut_short(path: str) -> bool:
+    """The file is an MCAP file without its summary or footer: a recorder killed."""
+    try:
+        with open(path, "rb") as f:
+            if f.read(len(MAGIC)) != MAGIC:
+                return False
+    except OSError:
+        return False
+    return summary_messages(path) is None
+
+
 def read_recording(path: str) -> Contents:
     """Every readable message of the recording `path` (`recording_files`), by log time. A file
     of several that cannot be read is a problem of the recording (a recorder killed as it
@@ -101,11 +128,6 @@ def read_recording(path: str) -> Contents:
     contents.messages.sort(key=lambda m: m.log_ns)
     contents.problem = "; ".join(problems)
     return contents
-
-
-# what a damaged file raises from inside the mcap reader
-READ_ERRORS = (McapError, struct.error, ValueError, UnicodeDecodeError, EOFError, MemoryError)
-RECORD_LIMIT = 1 << 30        # a longer record is damage, not a record
 
 
 class FileRecords:

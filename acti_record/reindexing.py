@@ -17,11 +17,10 @@ import shutil
 import tempfile
 from dataclasses import dataclass
 
-from mcap.reader import make_reader
 from mcap.records import (Attachment, Channel as McapChannel, Header, Message as McapMessage,
                           Metadata, Schema)
 
-from acti_record.reading import READ_ERRORS, FileRecords, channel_of
+from acti_record.reading import FileRecords, channel_of, summary_messages
 from acti_record.writing import LIBRARY, McapFile, Topic, check_not_written
 
 BAG_METADATA = "rosbag2"      # the metadata record rosbag2 reads, written again with new counts
@@ -46,7 +45,7 @@ def reindex_file(path: str) -> Reindexed:
     Raises `reading.BadRecording` for what cannot be reindexed (not MCAP, no complete chunk),
     `writing.RecordedElsewhere` for a file that a recorder is still writing."""
     check_not_written(path)
-    complete = _messages_in_summary(path)
+    complete = summary_messages(path)
     if complete is not None:
         return Reindexed(path, complete)
     folder, name = os.path.split(os.path.abspath(path))
@@ -61,18 +60,6 @@ def reindex_file(path: str) -> Reindexed:
         raise
     _sync_folder(folder)
     return Reindexed(path, records.messages, records.problem)
-
-
-def _messages_in_summary(path: str) -> int | None:
-    """The message count of a complete file (footer and summary readable), else None."""
-    try:
-        with open(path, "rb") as f:
-            summary = make_reader(f).get_summary()
-    except (OSError, *READ_ERRORS):
-        return None
-    if summary is None:
-        return None
-    return summary.statistics.message_count if summary.statistics else 0
 
 
 def _rewrite(path: str, into: str, name: str) -> FileRecords:

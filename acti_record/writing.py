@@ -13,11 +13,14 @@ from __future__ import annotations
 
 import fcntl
 import os
+import time
 from dataclasses import dataclass, field
 from typing import Any
 
 import yaml
 from mcap.writer import CompressionType, Writer
+
+from acti_record.reading import cut_short
 
 PROFILE = "ros2"
 SCHEMA_ENCODING = "ros2msg"
@@ -96,6 +99,22 @@ class _WriteThrough:
 
     def close(self) -> None:
         self._file.close()
+
+
+def keep_cut_file(path: str) -> str:
+    """A file at `path` that a kill cut short (MCAP without its summary or footer) renamed out
+    of the way of a new recording to `killed-<its time>-<name>` beside it, so that starting
+    again does not empty the recording of a crash; its new path, "" when there was none."""
+    if not os.path.exists(path):
+        return ""
+    check_not_written(path)
+    if not cut_short(path):
+        return ""
+    folder, name = os.path.split(path)
+    stamp = time.strftime("%Y%m%d-%H%M%S", time.localtime(os.path.getmtime(path)))
+    kept = os.path.join(folder, f"killed-{stamp}-{name}")
+    os.rename(path, kept)
+    return kept
 
 
 def check_not_written(path: str) -> None:
@@ -232,6 +251,7 @@ class Recording:
         self.path, self.max_bytes, self.max_duration_ns = path, max_bytes, int(max_duration_s * 1e9)
         self.compression = compression
         self.paths: list[str] = []
+        self.kept: list[tuple[str, str]] = []      # files a kill cut short: (path, renamed to)
         self.messages = 0
         self._file = self._open()
 
@@ -239,6 +259,9 @@ class Recording:
         split = self.max_bytes or self.max_duration_ns
         stem = self.path.removesuffix(".mcap")
         path = f"{stem}_{len(self.paths)}.mcap" if split else self.path
+        kept = keep_cut_file(path)
+        if kept:
+            self.kept.append((path, kept))
         self.paths.append(path)
         return McapFile(path, self.compression)
 

@@ -311,3 +311,23 @@ def test_what_cannot_be_reindexed_is_refused_in_one_line(tmp_path, content, says
     assert refused.stderr.count("\n") == 1 and says in refused.stderr, refused.stderr
     assert "Traceback" not in refused.stderr and bad.read_bytes() == before
     assert not [p for p in os.listdir(tmp_path) if p.endswith(".reindexing")]
+
+
+def test_a_new_recording_keeps_the_file_a_kill_cut_short_and_replaces_a_complete_one(tmp_path):
+    path = str(tmp_path / "session.mcap")
+    data = whole_file(path, count=500)
+    cut_copy(path, path + ".cut", os.path.getsize(path) // 2)
+    os.replace(path + ".cut", path)
+    recording = Recording(path)                       # the next session, same file
+    ((was, kept),) = recording.kept
+    assert was == path and os.path.basename(kept).startswith("killed-")
+    assert os.path.basename(kept).endswith("-session.mcap")
+    write(recording, strings(3))
+    recording.close()
+    assert len(read_recording(path).messages) == 3
+    done = reindex_file(kept)
+    assert 0 < done.messages < 500 and opened_by_its_summary(kept)[1][0][3] == data[0]
+    again = Recording(path)                           # a complete one is replaced, as before
+    again.close()
+    assert again.kept == [] and sorted(os.listdir(tmp_path)) == sorted(
+        [os.path.basename(kept), "session.mcap"])

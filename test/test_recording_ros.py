@@ -158,8 +158,9 @@ def _flushed(path: str):
 
 def test_a_recorder_killed_with_9_while_both_devices_move_leaves_a_file_reindexed_whole(
         ros, tmp_path):
-    """What the file held when the kill came is all read back, by rosbags once reindexed;
-    what is lost is what came after the recorder's last flush."""
+    """What the file held when the kill came is all read back, by rosbags once reindexed (what
+    is lost came after the recorder's last flush); the next recording to the same file keeps
+    it under another name."""
     moving = job(tmp_path, "moving")
     path = str(tmp_path / "killed.mcap")
     rec = recorder(path)                     # every topic: the job's clock, joints, TF …
@@ -185,11 +186,21 @@ def test_a_recorder_killed_with_9_while_both_devices_move_leaves_a_file_reindexe
     shown = run("acti_bringup.replay", path, "--topics", "/none")   # reads it, says what is lost
     assert shown.returncode == 0 and "ends early" in shown.stderr, shown.stdout + shown.stderr
 
+    listed = os.listdir(tmp_path)
+    again = recorder(path, "/none")          # the next session to the same file keeps this one
+    try:
+        assert wait_until(lambda: len(os.listdir(tmp_path)) > len(listed), 60.0)
+    finally:
+        again.send_signal(signal.SIGINT)
+        assert again.wait(timeout=30) == 0
+    (kept,) = [tmp_path / f for f in os.listdir(tmp_path) if f.startswith("killed-")]
+    assert f"{path} was cut short (its recorder killed): kept as {kept}" in again.stdout.read()
+    path = str(kept)
+
     reindexed = run("acti_bringup.reindex", path)
     assert reindexed.returncode == 0 and reindexed.stdout.startswith(f"reindexed {path} ("), \
         reindexed.stdout + reindexed.stderr
-    with AnyReader([tmp_path / "killed.mcap"],
-                   default_typestore=get_typestore(Stores.ROS2_JAZZY)) as bag:
+    with AnyReader([kept], default_typestore=get_typestore(Stores.ROS2_JAZZY)) as bag:
         read = [(c.topic, raw) for c, _, raw in bag.messages()]
         joints = [bag.deserialize(raw, c.msgtype) for c, _, raw in bag.messages()
                   if c.topic == "/joint_states"]
