@@ -66,6 +66,10 @@ def dump_yaml(value: Any) -> str:
 class RecordedElsewhere(OSError):
     """The file is being written by another process (a recorder holds its lock)."""
 
+    @classmethod
+    def of(cls, path: str) -> RecordedElsewhere:
+        return cls(f"{path} is being recorded (a recorder holds it): end the recorder first")
+
 
 class _WriteThrough:
     """The file under the MCAP writer, unbuffered: a finished chunk is in the file at once. The
@@ -78,7 +82,7 @@ class _WriteThrough:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             os.close(fd)
-            raise RecordedElsewhere(f"{path} is being recorded by another process") from None
+            raise RecordedElsewhere.of(path) from None
         os.ftruncate(fd, 0)
         self._file = open(fd, "wb", buffering=0)
 
@@ -112,7 +116,10 @@ def keep_cut_file(path: str) -> str:
         return ""
     folder, name = os.path.split(path)
     stamp = time.strftime("%Y%m%d-%H%M%S", time.localtime(os.path.getmtime(path)))
-    kept = os.path.join(folder, f"killed-{stamp}-{name}")
+    kept, n = os.path.join(folder, f"killed-{stamp}-{name}"), 1
+    while os.path.exists(kept):           # two kills within a second
+        n += 1
+        kept = os.path.join(folder, f"killed-{stamp}-{n}-{name}")
     os.rename(path, kept)
     return kept
 
@@ -123,8 +130,7 @@ def check_not_written(path: str) -> None:
         try:
             fcntl.flock(f, fcntl.LOCK_SH | fcntl.LOCK_NB)
         except BlockingIOError:
-            raise RecordedElsewhere(f"{path} is being recorded (a recorder holds it): end the "
-                                    "recorder first") from None
+            raise RecordedElsewhere.of(path) from None
 
 
 @dataclass

@@ -331,3 +331,9 @@ def test_a_new_recording_keeps_the_file_a_kill_cut_short_and_replaces_a_complete
     again.close()
     assert again.kept == [] and sorted(os.listdir(tmp_path)) == sorted(
         [os.path.basename(kept), "session.mcap"])
+    cut_copy(kept, path, 1000)                        # killed again within the same second
+    os.utime(path, ns=(os.stat(kept).st_mtime_ns,) * 2)
+    third = Recording(path)
+    third.close()
+    ((_, kept_too),) = third.kept
+    assert kept_too != kept and os.path.exists(kept) and os.path.exists(kept_too)
