@@ -7,8 +7,9 @@ channel per topic, message encoding `cdr`, metadata `offered_qos_profiles` (the 
 YAML, metadata version 9) and `topic_type_hash` (RIHS01); log time = receive time, publish time
 = the publisher's send time (ns since the epoch); a `rosbag2` metadata record holding the bag's
 metadata YAML. Chunks are small and reach the disk as soon as they are full, and the recorder
-flushes the one in progress every FLUSH_PERIOD_S: a process killed with -9 leaves a file whose complete chunks can all be read
-(`acti_record.reading`)."""
+flushes the one in progress every FLUSH_PERIOD_S: a process killed with -9 leaves a file whose
+complete chunks can all be read (`acti_record.reading`) and written again whole
+(`acti_record.reindexing`), which the next recording to the same name keeps (`keep_cut_file`)."""
 from __future__ import annotations
 
 import fcntl
