@@ -7,6 +7,11 @@ from dataclasses import dataclass
 import numpy as np
 
 
+def _floats(values: np.ndarray | list[float]) -> list[float]:
+    """A list as it is; an array (or a number) flattened into floats."""
+    return values if isinstance(values, list) else np.asarray(values, float).reshape(-1).tolist()
+
+
 @dataclass(frozen=True)
 class Trapezoid:
     """Normalised progress s(t) in [0, 1] with equal accel and decel time `ramp`.
@@ -18,12 +23,12 @@ class Trapezoid:
     ramp: float
 
     @classmethod
-    def for_axes(cls, distance: np.ndarray, max_speed: np.ndarray, ramp: float) -> "Trapezoid":
+    def for_axes(cls, distance: np.ndarray | list[float], max_speed: np.ndarray | list[float],
+                 ramp: float) -> "Trapezoid":
         """Profile for axes moving `distance` at no more than `max_speed` each (same units; a
         speed of 0 for an axis that moves takes for ever). Plain floats: for a handful of axes
-        numpy's per-call cost was most of a PTP accept's."""
-        d = np.asarray(distance, float).reshape(-1).tolist()
-        v = np.asarray(max_speed, float).reshape(-1).tolist()
+        numpy's per-call cost was most of a PTP accept's (lists of floats are taken as they are)."""
+        d, v = _floats(distance), _floats(max_speed)
         if len(v) == 1:
             v = v * len(d)
         if not any(d):

@@ -104,13 +104,14 @@ def value_error(what: str) -> Refused:
 
 def finite_vector(values: Iterable[float], length: int | tuple[int, ...], name: str) -> np.ndarray:
     """`values` as a float vector of an allowed length with only finite numbers, else VALUE_ERR."""
-    v = np.asarray(list(values), dtype=float).reshape(-1)
+    v = np.asarray(values if isinstance(values, list) else list(values), dtype=float).reshape(-1)
     allowed = (length,) if isinstance(length, int) else length
     if len(v) not in allowed:
         want = " or ".join(str(n) for n in allowed)
         raise value_error(f"{name} needs {want} values, got {len(v)}")
-    bad = [i for i, x in enumerate(v) if not math.isfinite(x)]
-    if bad:
+    floats = v.tolist()      # numpy's scalars one by one cost more than the rest of the check
+    if not all(map(math.isfinite, floats)):
+        bad = [i for i, x in enumerate(floats) if not math.isfinite(x)]
         raise value_error(f"{name}[{bad[0]}] is {v[bad[0]]}: every value must be a finite number")
     return v
 

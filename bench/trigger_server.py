@@ -12,7 +12,10 @@ driven by a spin_once loop), so the ratio measures the nodes' own cost, not an e
                                                            of both nodes) as /bare_replay/<node>/<op>:
                                                            a getter answers the reply the running main
                                                            job gave it once, any other operation an
-                                                           OK reply (motion id 1) and does nothing
+                                                           OK reply (motion id 1) and does nothing;
+                                                           served as the job serves them: the same
+                                                           QoS (SERVICE_QOS) and introspection (the
+                                                           job's default `service_introspection`)
 
 The replay server tells a call's cost over a bare node answering the same messages (what the
 ROS layer and, for a move, its plan cost) apart from its cost over a Trigger (which adds the
@@ -66,8 +69,12 @@ def follow_node() -> rclpy.node.Node:
 
 def replay_node(names: list[str]) -> rclpy.node.Node:
     """The services `names`, each answering one reply: a getter's fetched once from the running
-    job, another operation's an OK reply that accepted nothing."""
+    job, another operation's an OK reply that accepted nothing. With the job's QoS and its
+    default introspection, so that the ratio to it is the node's own cost, not a setting's."""
     from acti_bringup.harness import RosClient
+    from acti_bringup.recording.introspection import introspect
+    from acti_bringup.recording.job import RecordingConfig
+    from acti_bringup.serving.adapter import SERVICE_QOS
     fetch = RosClient("bare_replay_fetch")
     replies = {}
     for name in names:
@@ -80,7 +87,9 @@ def replay_node(names: list[str]) -> rclpy.node.Node:
     fetch.close()
     node = rclpy.create_node("bare_replay")
     for name in names:
-        node.create_service(SERVICES[name], REPLAY + name, lambda _req, _resp, r=replies[name]: r)
+        node.create_service(SERVICES[name], REPLAY + name, lambda _req, _resp, r=replies[name]: r,
+                            qos_profile=SERVICE_QOS)
+    introspect([node], RecordingConfig.service_introspection)
     return node
 
 
