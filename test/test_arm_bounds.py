@@ -326,3 +326,32 @@ def test_an_absolute_pose_no_joints_reach_is_value_err_on_a_full_queue_too(arm, 
     assert arm.device.full
     r = getattr(arm, op)((turned, 0.0, 0))
     assert r.code == R.VALUE_ERR and "no joint solution" in r.comment, r
+
+
+def test_a_short_ptp_move_is_checked_between_its_two_samples_too(arm, executor):  # noqa: F811
+    """A move under a degree has two samples, its ends, checked in plain floats when both lie
+    well inside the box: ends within the limit's margin are still checked between them (the
+    control point bulges past the ends' extreme), and a box the ends lie well inside accepts."""
+    start = [-85.5, 40.0, 0.0, -40.0, 0.0, 90.0, 90.0]
+    assert arm.move_ptp_joint_abs(start).ok
+    run_until(executor, lambda: not arm.device.busy, 30.0)
+    assert arm.set_control_point_offset(hg(dx=2000.0, dz=2000.0)).ok
+
+    def x_mm(j1_deg):                        # the control point's x over J1 (degree)
+        qs = np.radians(np.array(start)[None, :].repeat(len(j1_deg), 0))
+        qs[:, 0] = np.radians(j1_deg)
+        return arm.frames.tool_of(arm.kin.flange_many(qs))[:, 0, 3] * 1000.0
+    j1 = np.arange(-85.5, -85.5 + 91.0, 0.01)
+    peak = float(j1[np.argmax(x_mm(j1))])          # x is largest there: a bulge between ends
+    assert -85.0 < peak < 5.0
+    wide = (10000.0, -10000.0)
+    assert arm.set_soft_limit_cartesian(wide, wide, wide).ok
+    assert arm.move_ptp_joint_abs([peak - 0.45] + start[1:]).ok
+    run_until(executor, lambda: not arm.device.busy, 30.0)
+    ends = float(x_mm(np.array([peak - 0.45, peak + 0.45])).max())
+    assert float(x_mm(np.array([peak]))[0]) > ends + 0.05
+    assert arm.set_soft_limit_cartesian((ends + 0.01, -10000.0), wide, wide).ok
+    step = [0.9] + [0.0] * 6
+    assert _accepted_then_run(arm, executor, arm.move_ptp_joint_rel(step)) == "refused"
+    assert arm.set_soft_limit_cartesian((ends + 100.0, -10000.0), wide, wide).ok
+    assert _accepted_then_run(arm, executor, arm.move_ptp_joint_rel(step)) == "ran"

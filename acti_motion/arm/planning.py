@@ -19,7 +19,7 @@ from typing import Callable, Iterator
 import numpy as np
 from scipy.interpolate import PPoly
 
-from acti_motion.arm.kinematics import Unreachable, rotate_about
+from acti_motion.arm.kinematics import FEW_POSTURES, Unreachable, rotate_about
 from acti_motion.arm.poses import Frames, inverse
 from acti_motion.arm.trajectories import (ArmMotion, ArmSetpoint, CartesianLimits,
                                           CartesianPath, CartesianPlanner, LinearJointPath,
@@ -52,6 +52,17 @@ def _near_limits_refined(ss: np.ndarray, values: np.ndarray, evaluate: Callable[
     extra = (ss[todo, None] + (ss[todo + 1] - ss[todo])[:, None] * t).ravel()
     order = np.argsort(np.concatenate([ss, extra]), kind="stable")
     return np.vstack([values, evaluate(extra)])[order]
+
+
+def _well_inside(values: np.ndarray, bounds: np.ndarray, margin: float) -> bool:
+    """Every row of a few samples (at most FEW_POSTURES) lies more than `margin` inside the
+    bounds (rows: lower, upper): then no sample is near a limit (nothing to refine) and none
+    is outside. In plain floats: on a cold core a short PTP move's numpy checks of its two
+    samples cost ~25 µs of its accept; a longer path goes to numpy (False)."""
+    if len(values) > FEW_POSTURES:
+        return False
+    box = [(lo + margin, hi - margin) for lo, hi in bounds.tolist()]
+    return all(lo < v < hi for row in values.tolist() for v, (lo, hi) in zip(row, box))
 
 
 def _first_exit(values: np.ndarray, lower: np.ndarray, upper: np.ndarray,
@@ -199,9 +210,10 @@ class MovePlanning:
             def positions_mm(ss: np.ndarray) -> np.ndarray:
                 qs = path.q0 + ss[:, None] * path.delta
                 return frames.tool_of(self.kin.flange_many(qs))[:, :3, 3] * 1000.0
-            lim = self.soft_limit_cartesian
-            self._check_cartesian_positions(_near_limits_refined(
-                ss, positions_mm(ss), positions_mm, lim[:, 0], lim[:, 1], NEAR_LIMIT_MM), label)
+            lim, positions = self.soft_limit_cartesian, positions_mm(ss)
+            if not _well_inside(positions, lim, NEAR_LIMIT_MM):
+                self._check_cartesian_positions(_near_limits_refined(
+                    ss, positions, positions_mm, lim[:, 0], lim[:, 1], NEAR_LIMIT_MM), label)
             timing = Trapezoid.for_axes(delta, speed, ramp)
             return ArmMotion(path, timing, start.finger, start.finger, ramp, "joint")
         return self._submit(plan, label)
