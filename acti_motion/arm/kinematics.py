@@ -72,7 +72,7 @@ def rotate_many(axes: np.ndarray, angles: np.ndarray, v: np.ndarray) -> np.ndarr
     """Each vector v[i] (or the one v) turned by angles[i] about the unit axes[i] (Rodrigues)."""
     c, s = np.cos(angles)[:, None], np.sin(angles)[:, None]
     return (v * c + cross_many(axes, v) * s
-            + axes * (np.sum(axes * v, axis=1)[:, None] * (1.0 - c)))
+            + axes * ((axes * v).sum(axis=1)[:, None] * (1.0 - c)))
 
 
 def exp3_many(w: np.ndarray) -> np.ndarray:

@@ -20,7 +20,7 @@ import numpy as np
 from scipy.interpolate import PPoly
 
 from acti_motion.arm.kinematics import FEW_POSTURES, Unreachable, rotate_about
-from acti_motion.arm.poses import Frames, inverse
+from acti_motion.arm.poses import Frames
 from acti_motion.arm.trajectories import (ArmMotion, ArmSetpoint, CartesianLimits,
                                           CartesianPath, CartesianPlanner, LinearJointPath,
                                           LinePath, convex_checkpoints, positions_along,
@@ -135,7 +135,7 @@ class MovePlanning:
         hand and control-point offset reach, else VALUE_ERR: checked before any IK or planning,
         so a target kilometres away is refused at once."""
         kin = self.kin
-        to_robot = inverse(frames.base)
+        to_robot = frames.base_inverse
         shoulder = to_robot[:3, :3] @ kin.shoulder + to_robot[:3, 3]
         radius = self.planner.reach_radius(frames)
         dist = np.linalg.norm(positions - shoulder, axis=1)
@@ -280,7 +280,7 @@ class MovePlanning:
                 self.planner.check_length(path, frames)
             except ValueError as e:
                 raise value_error(f"{label}: {e}") from None
-            coarse = convex_checkpoints(path, np.linspace(0.0, 1.0, REACH_SAMPLES + 1))
+            coarse = convex_checkpoints(path, REACH_SAMPLES)
             self._check_cartesian_positions(coarse * 1000.0, label)
             self._check_reach(coarse, frames, label)
             if not isinstance(path, LinePath):       # a line's ends told it all (convex)

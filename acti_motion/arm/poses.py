@@ -104,7 +104,8 @@ class Frames:
         self.base = np.eye(4) if base is None else base
         self.tool = np.eye(4) if tool is None else tool
         self.base_hg = pose_to_hg(self.base) if base_hg is None else base_hg   # as set
-        self._base_inv, self._tool_inv = inverse(self.base), inverse(self.tool)
+        self.base_inverse, self._tool_inv = inverse(self.base), inverse(self.tool)
+        self.tool_reach = float(np.linalg.norm(self.tool[:3, 3]))   # m: control point ↔ flange
         self._plain = bool(np.array_equal(self.base, _IDENTITY)
                            and np.array_equal(self.tool, _IDENTITY))
 
@@ -123,4 +124,4 @@ class Frames:
 
     def tool_of(self, F: np.ndarray) -> np.ndarray:
         """Control-point pose (robot frame) of the flange pose F (arm frame); F without offsets."""
-        return F if self._plain else self._base_inv @ F @ self.tool
+        return F if self._plain else self.base_inverse @ F @ self.tool

@@ -296,14 +296,14 @@ def positions_along(path: CartesianPath, ss: np.ndarray) -> np.ndarray:
     return np.array([path.position(s) for s in ss])
 
 
-def convex_checkpoints(path: CartesianPath, ss: np.ndarray) -> np.ndarray:
+def convex_checkpoints(path: CartesianPath, intervals: int) -> np.ndarray:
     """Positions of `path` (N×3) that tell whether it keeps to a convex region (the soft-limit
     box, the reach's ball) and where it first leaves one: a line's two ends (a line leaves a
     convex region at most once, so its end is outside if and only if it does), else the
-    positions at ss."""
+    positions at `intervals` + 1 evenly spaced points."""
     if isinstance(path, LinePath):
         return positions_along(path, np.array([0.0, 1.0]))
-    return positions_along(path, ss)
+    return positions_along(path, np.linspace(0.0, 1.0, intervals + 1))
 
 
 # --- planning ---------------------------------------------------------------------------------------
@@ -350,7 +350,7 @@ class CartesianPlanner:
     def reach_radius(self, frames: Frames) -> float:
         """Radius (m) of the ball about the shoulder that holds every control point the arm
         reaches: arm, hand and the control-point offset."""
-        return self.kin.reach + self.kin.hand + float(np.linalg.norm(frames.tool[:3, 3]))
+        return self.kin.reach + self.kin.hand + frames.tool_reach
 
     def check_length(self, path: CartesianPath, frames: Frames) -> None:
         """Unreachable when `path` (a line or arc of this module) is longer than any path within
@@ -471,7 +471,7 @@ class _ElbowPlan:
         i = np.minimum((ss * last).astype(int), last - 1)
         f = ((ss - self.grid[i]) / (self.grid[i + 1] - self.grid[i]))[:, None]
         n = (1 - f) * self.base[i] + f * self.base[i + 1]
-        n = _units(n - np.sum(n * us, axis=1)[:, None] * us)
+        n = _units(n - np.einsum("ij,ij->i", n, us)[:, None] * us)
         return rotate_many(us, self.turn * ss, n) if self.turn else n
 
 
@@ -602,4 +602,5 @@ def _strays(want: np.ndarray, got: np.ndarray) -> np.ndarray:
 
 
 def _units(v: np.ndarray) -> np.ndarray:
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+    """The rows of v (N×3) scaled to length 1."""
+    return v / np.sqrt(np.einsum("ij,ij->i", v, v))[:, None]
