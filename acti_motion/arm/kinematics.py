@@ -223,15 +223,22 @@ class ArmKinematics:
         return float(math.hypot(u[0], u[2]))
 
     def elbow_direction(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(u, n): the unit S→W and the unit direction from the elbow circle's centre to E."""
+        """(u, n): the unit S→W and the unit direction from the elbow circle's centre to E
+        (read-only). The thread's last answer is kept: a CP plan asks for its start's twice."""
+        q = np.asarray(q, float)
+        key = q.tobytes()
+        last = getattr(self._local, "elbow", None)
+        if last is not None and last[0] == key:
+            return last[1]
         pts = self.points(q)
         u = _unit(pts.wrist - pts.shoulder)
         v = pts.elbow - pts.shoulder
         n = v - np.dot(v, u) * u
         norm = np.linalg.norm(n)
-        if norm < 1e-9:                      # stretched straight: any elbow angle; report 0
-            return u, self.reference(u)[0]
-        return u, n / norm
+        n = self.reference(u)[0] if norm < 1e-9 else n / norm   # stretched: any angle; report 0
+        u.flags.writeable = n.flags.writeable = False
+        self._local.elbow = (key, (u, n))
+        return u, n
 
     def angle_of(self, u: np.ndarray, n: np.ndarray) -> float:
         e1, e2 = self.reference(u)

@@ -151,7 +151,7 @@ class MovePlanning:
         """A relative step (4×4, m) longer than the reach's ball is wide ends out of reach from
         any start: VALUE_ERR before the queue is looked at (a full queue would have hidden it)."""
         diameter = 2.0 * self.planner.reach_radius(self.frames)
-        step = float(np.linalg.norm(delta[:3, 3]))
+        step = math.hypot(*delta[:3, 3].tolist())
         if step > diameter + 1e-9:
             raise value_error(f"{label}: a step of {step * 1e3:.6g} mm is out of reach from any "
                               f"start: the arm reaches {diameter * 1e3:.1f} mm across")

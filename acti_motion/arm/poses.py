@@ -36,13 +36,17 @@ def hg_to_pose(values: Iterable[float], name: str,
         raise Refused(code, r.comment) from None
     m = v.reshape(3, 4)
     R = m[:, :3]
-    if np.max(np.abs(R)) > 1.0 + ROTATION_TOLERANCE:      # no rotation has such entries
+    largest = float(np.abs(R).max())
+    if largest > 1.0 + ROTATION_TOLERANCE:      # no rotation has such entries
         raise Refused(code, f"{name}: the 3×3 part is not a rotation: an entry is "
-                            f"{float(np.max(np.abs(R))):.6g}, a rotation's are within ±1")
-    err = float(np.max(np.abs(R.T @ R - np.eye(3))))
-    if err > ROTATION_TOLERANCE or np.linalg.det(R) <= 0:
+                            f"{largest:.6g}, a rotation's are within ±1")
+    gram = R.T @ R
+    gram.flat[::4] -= 1.0
+    err = float(np.abs(gram).max())
+    det = _det3(R.tolist())
+    if err > ROTATION_TOLERANCE or det <= 0:
         raise Refused(code, f"{name}: the 3×3 part is not a rotation (orthonormal, det +1): "
-                            f"|RᵀR − I| = {err:.3g}, det = {np.linalg.det(R):.3g}")
+                            f"|RᵀR − I| = {err:.3g}, det = {det:.3g}")
     T = np.eye(4)
     if err > EXACT_ROTATION:             # made orthonormal; an exact one keeps its last digits
         u, _, vt = np.linalg.svd(R)
@@ -50,6 +54,12 @@ def hg_to_pose(values: Iterable[float], name: str,
     T[:3, :3] = R
     T[:3, 3] = m[:, 3] / 1000.0
     return T
+
+
+def _det3(r: list[list[float]]) -> float:
+    """The determinant of a 3×3 matrix given as rows (plain floats: a tenth of numpy's cost)."""
+    (a, b, c), (d, e, f), (g, h, i) = r
+    return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
 
 
 def pose_to_hg(T: np.ndarray) -> list[float]:

@@ -222,8 +222,8 @@ class LinePath:
         self.p0, self.dp = P0[:3, 3].copy(), P1[:3, 3] - P0[:3, 3]
         self.R0 = P0[:3, :3].copy()
         self.w = pin.log3(P1[:3, :3] @ self.R0.T)
-        self.length = float(np.linalg.norm(self.dp))
-        self.angle = float(np.linalg.norm(self.w))
+        self.length = math.hypot(*self.dp.tolist())
+        self.angle = math.hypot(*self.w.tolist())
 
     def positions(self, ss: np.ndarray) -> np.ndarray:
         """Positions at each s (N×3)."""
@@ -339,12 +339,12 @@ class CartesianPlanner:
         elbow = self._elbow_plan(path, frames.flange_of, start_q, psi, turn)
         turn = elbow.turn
         spline = self._sample(path, frames, start_q, elbow)
-        extents = np.array([path.length, path.angle, abs(turn)])
-        speeds = np.array([limits.speed, limits.angular_speed, limits.angular_speed])
+        extents = [path.length, path.angle, abs(turn)]
+        speeds = [limits.speed, limits.angular_speed, limits.angular_speed]
         nominal = Trapezoid.for_axes(extents, speeds, limits.ramp)
         if keeps_limits(spline, nominal, limits):
             return CartesianPlan(spline, nominal, False)
-        timing = time_optimal(spline.ss, spline.qs, extents, limits)
+        timing = time_optimal(spline.ss, spline.qs, np.array(extents), limits)
         return CartesianPlan(spline, timing, True)
 
     def reach_radius(self, frames: Frames) -> float:
@@ -393,9 +393,10 @@ class CartesianPlanner:
         qs = ik.chain(ss, np.asarray(start_q, float))
         # refine where a joint steps too far (a fast joint near a singularity, or a branch jump)
         for _ in range(40):
-            todo = np.flatnonzero(np.max(np.abs(np.diff(qs, axis=0)), axis=1) > MAX_JOINT_STEP)
-            if not len(todo):
+            steps = np.abs(qs[1:] - qs[:-1])
+            if steps.max() <= MAX_JOINT_STEP:
                 break
+            todo = np.flatnonzero(steps.max(axis=1) > MAX_JOINT_STEP)
             ss, qs = _insert(ss, qs, todo, ik.between)
             if len(ss) > MAX_SAMPLES or np.min(np.diff(ss)) < 1e-7:
                 raise Unreachable("the path runs through a singularity (a joint would jump)")
