@@ -347,9 +347,9 @@ class ArmKinematics:
                               reference)
         if chained:     # each nearest the one before: whole turns that add up along the poses
             steps = q - np.concatenate([reference[None], q[:-1]])
-            q = q - TWO_PI * np.cumsum(np.round(steps / TWO_PI), axis=0)
+            q = q - TWO_PI * np.rint(steps / TWO_PI).cumsum(axis=0)
         else:
-            q = q + TWO_PI * np.round((reference - q) / TWO_PI)
+            q = q + TWO_PI * np.rint((reference - q) / TWO_PI)
         ok = ((dist <= self.reach + 1e-9) & (dist >= self.min_reach - 1e-9)
               & (np.abs(q[:, 1::2]).min(axis=1) > CLEAR)
               & (np.abs(reference[..., 1::2]).min(axis=-1) > CLEAR)
@@ -380,7 +380,7 @@ class ArmKinematics:
         t5 = np.where(wrist_free, ref[..., 4], np.arctan2(s6 * rw[:, 1, 2], s6 * rw[:, 0, 2]))
         t7 = np.where(wrist_free, np.arctan2(rw[:, 1, 0], rw[:, 0, 0]) - ref[..., 4],
                       np.arctan2(s6 * rw[:, 2, 1], -s6 * rw[:, 2, 0]))
-        return np.stack([t1, t2, t3, t4, t5, t6, t7], axis=1)
+        return np.array([t1, t2, t3, t4, t5, t6, t7]).T
 
     @staticmethod
     def _nearest_turns(q: np.ndarray, ref: np.ndarray, lower: np.ndarray,
