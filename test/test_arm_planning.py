@@ -12,7 +12,8 @@ from scipy.interpolate import CubicSpline
 from acti_motion.arm.core import ArmConfig, ArmCore, shared_kinematics
 from acti_motion.arm.poses import Frames, pose_to_hg
 from acti_motion.arm.trajectories import (TOPPRA_GRID, ArcPath, CartesianLimits, CartesianPlanner,
-                                          LinePath, bounds_keep_limits, keeps_limits,
+                                          LinePath, _pieces_at, bounds_keep_limits,
+                                          keeps_limits, not_a_knot_coefficients,
                                           not_a_knot_spline, poses_along, positions_along,
                                           samples_keep_limits, spline_within, time_optimal,
                                           toppra_grid)
@@ -157,6 +158,9 @@ def test_the_joint_spline_is_scipy_s_not_a_knot_cubic_spline(n):
     assert np.allclose(ours.c, theirs.c, rtol=1e-12, atol=1e-12)
     ts = np.linspace(-0.01, 1.01, 301)                 # extrapolates like CubicSpline too
     assert np.allclose(ours(ts), theirs(ts), rtol=1e-12, atol=1e-12)
+    mids = (xs[:-1] + xs[1:]) / 2                      # the pieces at their middles at once
+    assert np.allclose(_pieces_at(not_a_knot_coefficients(xs, ys), mids - xs[:-1]),
+                       theirs(mids), rtol=1e-12, atol=1e-12)
 
 
 def test_toppra_is_imported_with_the_planner():
@@ -187,7 +191,7 @@ def test_the_limits_bound_says_keeps_only_where_every_sample_keeps(kin):
     for spline, nominal in _plans_and_profiles(kin):
         sampled = samples_keep_limits(spline, nominal, lim)
         assert keeps_limits(spline, nominal, lim) == sampled
-        if bounds_keep_limits(spline.spline, nominal, lim):
+        if bounds_keep_limits(spline, nominal, lim):
             assert sampled
             by_bound += 1
         answers.add(sampled)
@@ -202,8 +206,8 @@ def test_the_spline_bound_says_within_only_where_every_point_is(kin):
     for spline in splines:
         fine = spline.spline(np.linspace(0.0, 1.0, 20001))
         low, high = fine.min(axis=0), fine.max(axis=0)
-        assert not spline_within(spline.spline, low + 1e-9, high + 1.0)
-        assert not spline_within(spline.spline, low - 1.0, high - 1e-9)
-    short = next(iter(splines)).spline
-    fine = short(np.linspace(0.0, 1.0, 20001))
+        assert not spline_within(spline, low + 1e-9, high + 1.0)
+        assert not spline_within(spline, low - 1.0, high - 1e-9)
+    short = next(iter(splines))
+    fine = short.spline(np.linspace(0.0, 1.0, 20001))
     assert spline_within(short, fine.min(axis=0) - 1e-3, fine.max(axis=0) + 1e-3)

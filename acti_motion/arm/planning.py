@@ -17,14 +17,13 @@ from contextlib import contextmanager
 from typing import Callable, Iterator
 
 import numpy as np
-from scipy.interpolate import PPoly
 
 from acti_motion.arm.kinematics import FEW_POSTURES, Unreachable, rotate_about
 from acti_motion.arm.poses import Frames
 from acti_motion.arm.trajectories import (ArmMotion, ArmSetpoint, CartesianLimits,
                                           CartesianPath, CartesianPlanner, LinearJointPath,
-                                          LinePath, convex_checkpoints, positions_along,
-                                          spline_within)
+                                          LinePath, SplineJointPath, convex_checkpoints,
+                                          positions_along, spline_within)
 from acti_motion.profiles import Trapezoid
 from acti_motion.replies import Refused, Reply, ReturnCode, value_error
 
@@ -174,7 +173,7 @@ class MovePlanning:
             raise value_error(f"{label}: the path leaves the joint soft limit: J{j + 1} = "
                               f"{qs_deg[k, j]:.10g}°, limit [{lim[j, 0]:g}, {lim[j, 1]:g}]°")
 
-    def _check_joint_spline(self, spline: PPoly, label: str) -> None:
+    def _check_joint_spline(self, spline: SplineJointPath, label: str) -> None:
         """A CP path's joint spline within the joint soft limits: at once where a bound over
         each piece keeps it clear of them (as the samples would find), else at 4 samples per
         IK sample, finer near a limit."""
@@ -182,10 +181,10 @@ class MovePlanning:
         if spline_within(spline, np.radians(lim[:, 0] + NEAR_LIMIT_DEG),
                          np.radians(lim[:, 1] - NEAR_LIMIT_DEG)):
             return
-        dense = np.linspace(0.0, 1.0, 4 * len(spline.x))
+        dense = np.linspace(0.0, 1.0, 4 * len(spline.ss))
 
         def joints_deg(ss: np.ndarray) -> np.ndarray:
-            return np.degrees(spline(ss))
+            return np.degrees(spline.spline(ss))
         self._check_joint_path(_near_limits_refined(
             dense, joints_deg(dense), joints_deg, lim[:, 0], lim[:, 1], NEAR_LIMIT_DEG), label)
 
@@ -294,7 +293,7 @@ class MovePlanning:
                                            turn=goal_turn)
             except Unreachable as e:
                 raise value_error(f"{label}: {e}") from None
-            self._check_joint_spline(result.path.spline, label)
+            self._check_joint_spline(result.path, label)
             return ArmMotion(result.path, result.timing, start.finger, start.finger, ramp,
                              "cartesian")
         return self._submit(plan, label)

@@ -86,8 +86,14 @@ class LinearJointPath:
 def not_a_knot_spline(xs: np.ndarray, ys: np.ndarray) -> PPoly:
     """The cubic spline through (xs[i], ys[i]) (ys: N×dof, N ≥ 4) with not-a-knot ends: the
     one scipy's CubicSpline(xs, ys, axis=0) builds, by the same equations, without its input
-    checks (a sixth of a short CP plan). A few points (a short line) are solved densely:
-    LAPACK's banded solver through scipy costs more than numpy's dense one up to ~16."""
+    checks (a sixth of a short CP plan)."""
+    return PPoly.construct_fast(not_a_knot_coefficients(xs, ys), np.asarray(xs, float))
+
+
+def not_a_knot_coefficients(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+    """The coefficients (4 × pieces × dof, highest power first, as PPoly's) of
+    `not_a_knot_spline`. A few points (a short line) are solved densely: LAPACK's banded
+    solver through scipy costs more than numpy's dense one up to ~16."""
     dx = xs[1:] - xs[:-1]
     slope = (ys[1:] - ys[:-1]) / dx[:, None]
     h = dx.tolist()
@@ -115,7 +121,13 @@ def not_a_knot_spline(xs: np.ndarray, ys: np.ndarray) -> PPoly:
     c[1] = (slope - ds[:-1]) / dxc - t
     c[2] = ds[:-1]
     c[3] = ys[:-1]
-    return PPoly.construct_fast(c, np.asarray(xs, float))
+    return c
+
+
+def _pieces_at(c: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """Each piece of the cubic spline with coefficients c at its own offset from its start."""
+    t = offsets[:, None]
+    return c[3] + t * (c[2] + t * (c[1] + t * c[0]))
 
 
 _D1 = np.array([3.0, 2.0, 1.0])[:, None, None]    # a cubic's coefficients → its derivatives
@@ -125,13 +137,14 @@ _D2 = np.array([6.0, 2.0])[:, None, None]
 class SplineJointPath:
     """A cubic spline through IK samples (s_i, q_i) of a Cartesian path."""
 
-    def __init__(self, ss: np.ndarray, qs: np.ndarray, spline: PPoly | None = None) -> None:
-        """`spline`: the one through (ss, qs) when the caller built it already."""
+    def __init__(self, ss: np.ndarray, qs: np.ndarray, c: np.ndarray | None = None) -> None:
+        """`c`: the spline's coefficients when the caller has them (`not_a_knot_coefficients`);
+        kept, as PPoly's `c` property converts its array on every reading."""
         self.ss, self.qs = ss, qs
-        self.spline = not_a_knot_spline(ss, qs) if spline is None else spline
-        c, x = self.spline.c, self.spline.x      # PPoly.derivative's, without its checks
-        self.d1 = PPoly.construct_fast(c[:-1] * _D1, x)
-        self.d2 = PPoly.construct_fast(c[:-2] * _D2, x)
+        self.c = not_a_knot_coefficients(ss, qs) if c is None else c
+        self.spline = PPoly.construct_fast(self.c, ss)
+        self.d1 = PPoly.construct_fast(self.c[:-1] * _D1, ss)   # PPoly.derivative's, unchecked
+        self.d2 = PPoly.construct_fast(self.c[:-2] * _D2, ss)
 
     def q(self, s: float) -> np.ndarray:
         return self.spline(s)
@@ -402,12 +415,12 @@ class CartesianPlanner:
                 raise Unreachable("the path runs through a singularity (a joint would jump)")
         # refine where the spline strays from the path
         for _ in range(8):
-            spline = not_a_knot_spline(ss, qs)
+            c = not_a_knot_coefficients(ss, qs)
             mids = (ss[:-1] + ss[1:]) / 2
-            got = frames.tool_of(kin.flange_many(spline(mids)))
+            got = frames.tool_of(kin.flange_many(_pieces_at(c, mids - ss[:-1])))
             todo = np.flatnonzero(_strays(poses_along(path, mids), got))
             if not len(todo):
-                return SplineJointPath(ss, qs, spline)
+                return SplineJointPath(ss, qs, c)
             ss, qs = _insert(ss, qs, todo, ik.between)
         return SplineJointPath(ss, qs)
 
@@ -416,7 +429,7 @@ def keeps_limits(spline: SplineJointPath, nominal: Trapezoid, limits: CartesianL
     """Whether the joints keep their velocity and acceleration limits along `spline` timed by
     the nominal profile: at 401 instants (`samples_keep_limits`), decided at once where bounds
     over the whole path already say so (`bounds_keep_limits`, a short CP line's usual case)."""
-    return (nominal.duration <= 0.0 or bounds_keep_limits(spline.spline, nominal, limits)
+    return (nominal.duration <= 0.0 or bounds_keep_limits(spline, nominal, limits)
             or samples_keep_limits(spline, nominal, limits))
 
 
@@ -431,7 +444,8 @@ def samples_keep_limits(spline: SplineJointPath, nominal: Trapezoid,
                 and np.all(np.abs(qdd) <= limits.joint_accel * (1 + 1e-3)))
 
 
-def bounds_keep_limits(spline: PPoly, nominal: Trapezoid, limits: CartesianLimits) -> bool:
+def bounds_keep_limits(spline: SplineJointPath, nominal: Trapezoid,
+                       limits: CartesianLimits) -> bool:
     """A sufficient condition for `samples_keep_limits`, in a few numpy calls: with |q'(s)| ≤ M1
     and |q''(s)| ≤ M2 over the whole cubic spline (bounds per piece: q' is a quadratic, q''
     linear, on [0, h]), ṡ ≤ the profile's peak v and |s̈| ≤ v / ramp, the joint velocity q'ṡ is
@@ -440,7 +454,7 @@ def bounds_keep_limits(spline: PPoly, nominal: Trapezoid, limits: CartesianLimit
     if nominal.ramp <= 0.0:
         return False
     c = np.abs(spline.c)                         # (4, pieces, dof): x³, x², x, 1 coefficients
-    h = (spline.x[1:] - spline.x[:-1])[:, None]
+    h = (spline.ss[1:] - spline.ss[:-1])[:, None]
     m1 = (c[2] + h * (2.0 * c[1] + 3.0 * h * c[0])).max(axis=0)
     m2 = (2.0 * c[1] + 6.0 * h * c[0]).max(axis=0)
     v = nominal.peak
@@ -448,12 +462,12 @@ def bounds_keep_limits(spline: PPoly, nominal: Trapezoid, limits: CartesianLimit
                 and (m2 * v * v + m1 * v / nominal.ramp <= limits.joint_accel).all())
 
 
-def spline_within(spline: PPoly, lower: np.ndarray, upper: np.ndarray) -> bool:
+def spline_within(spline: SplineJointPath, lower: np.ndarray, upper: np.ndarray) -> bool:
     """Whether a cubic spline stays within [lower, upper] (per axis) between its first and last
     breakpoints, by a bound per piece: q(x) = c₃ + c₂x + x²(c₁ + c₀x) on [0, h] is within
     h²(|c₁| + h|c₀|) of the chord c₃ + c₂x. A sufficient condition: False says nothing."""
     c = spline.c
-    h = (spline.x[1:] - spline.x[:-1])[:, None]
+    h = (spline.ss[1:] - spline.ss[:-1])[:, None]
     bend = h * h * (np.abs(c[1]) + h * np.abs(c[0]))
     end = c[3] + h * c[2]
     return bool((np.minimum(c[3], end) - bend >= lower).all()
