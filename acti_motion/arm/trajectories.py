@@ -199,11 +199,16 @@ class ArmMotion:
         self.duration = timing.duration
         self.limits_checked: np.ndarray | None = None   # the soft limits its plan was checked with
         self._applied: tuple[float, ArmSetpoint] | None = None
+        self._end: ArmSetpoint | None = None
 
     def at(self, t: float) -> ArmSetpoint:
         applied = self._applied
         if applied is not None and applied[0] == t:     # the soft-limit watch, after `apply`
             return applied[1]
+        if t >= self.duration:      # every timing is at s = 1 there; the queue asks it twice
+            if self._end is None:
+                self._end = ArmSetpoint(self.path.q(1.0), self.finger0 + self.dfinger)
+            return self._end
         s, _ = self.timing.sample(t)
         return ArmSetpoint(self.path.q(s), self.finger0 + s * self.dfinger)
 
