@@ -109,12 +109,13 @@ def _handler(node: Node, op: Operation, method: Callable[..., Reply],
     returned."""
     read = request_reader(op.srv_type.Request)
     last: tuple[Any, Any] = (None, None)      # the last reply, hashable, and its response
+    plans = getattr(method, "plans", False)   # a move: each accept answers a new motion id
 
     def handle(request: Any, response: Any) -> Any:
         nonlocal last
         try:
             reply = method(**read(request))
-            key = reply_key(reply.code, reply.comment, reply.values)
+            key = None if plans else reply_key(reply.code, reply.comment, reply.values)
             if key is not None and key == last[0]:
                 return last[1]
             write_status(response, reply)

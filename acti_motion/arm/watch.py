@@ -12,7 +12,7 @@ from __future__ import annotations
 import threading
 from dataclasses import dataclass
 from enum import IntEnum
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
@@ -176,8 +176,24 @@ class SoftLimitWatch:
         return f"alarm 0x{alarm.code:X} ({alarm.description})"
 
     def _limit_rows(self) -> np.ndarray:
-        """The soft limits as rows (lower, upper): J1 … J7 (degree), then x, y, z (mm)."""
-        return np.concatenate([self.soft_limit_joint, self.soft_limit_cartesian])
+        """The soft limits as rows (lower, upper): J1 … J7 (degree), then x, y, z (mm); read-only,
+        made again only when a limit was set (`_for_limits`): every accept and every moving
+        step reads them."""
+        def rows(lj: np.ndarray, lc: np.ndarray) -> np.ndarray:
+            made = np.concatenate([lj, lc])
+            made.flags.writeable = False
+            return made
+        return self._for_limits("_rows_made", rows)
+
+    def _for_limits(self, name: str, build: Callable[[np.ndarray, np.ndarray], Any]) -> Any:
+        """build(joint soft limits, Cartesian soft limits), kept as attribute `name` and made
+        again only when a limit was set (each setter assigns new arrays)."""
+        lj, lc = self.soft_limit_joint, self.soft_limit_cartesian
+        made = getattr(self, name, None)
+        if made is None or made[0] is not lj or made[1] is not lc:
+            made = (lj, lc, build(lj, lc))
+            setattr(self, name, made)
+        return made[2]
 
     def _watched_values(self, q: np.ndarray) -> np.ndarray:
         """Joint values (degree) and control-point position (mm) of set-point q: the rows of
@@ -194,13 +210,10 @@ class SoftLimitWatch:
 
     def _watch_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """The soft limits widened by the watch tolerances (lower, upper), made again only when
-        a limit was set (each setter assigns new arrays): the watch runs every moving step."""
-        lj, lc = self.soft_limit_joint, self.soft_limit_cartesian
-        made = getattr(self, "_bounds_made", None)
-        if made is None or made[0] is not lj or made[1] is not lc:
-            lower = np.concatenate([lj[:, 0] - JOINT_WATCH_TOLERANCE_DEG,
-                                    lc[:, 0] - CARTESIAN_WATCH_TOLERANCE_MM])
-            upper = np.concatenate([lj[:, 1] + JOINT_WATCH_TOLERANCE_DEG,
-                                    lc[:, 1] + CARTESIAN_WATCH_TOLERANCE_MM])
-            made = self._bounds_made = (lj, lc, lower, upper)
-        return made[2], made[3]
+        a limit was set (`_for_limits`): the watch runs every moving step."""
+        def bounds(lj: np.ndarray, lc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            return (np.concatenate([lj[:, 0] - JOINT_WATCH_TOLERANCE_DEG,
+                                    lc[:, 0] - CARTESIAN_WATCH_TOLERANCE_MM]),
+                    np.concatenate([lj[:, 1] + JOINT_WATCH_TOLERANCE_DEG,
+                                    lc[:, 1] + CARTESIAN_WATCH_TOLERANCE_MM]))
+        return self._for_limits("_bounds_made", bounds)
