@@ -67,7 +67,7 @@ def test_the_arm_control_plane_never_waits_for_a_plan(arm):  # noqa: F811
 
 
 @pytest.mark.parametrize("core, operations, expected", [
-    ("base", BASE_OPERATIONS, {"set_velocity", "set_acceleration", "set_position", "set_joystick"}),
+    ("base", BASE_OPERATIONS, {"set_acceleration", "set_position", "set_joystick"}),
     ("arm", ARM_OPERATIONS, {"go_home", "open_gripper", "close_gripper", "move_gripper"}),
 ])
 def test_moves_and_what_retimes_or_reframes_them_are_marked_as_planning(request, core,

@@ -115,6 +115,7 @@ class VehicleNode(Node):
         planner.start()        # TOPP-RA plans in a process of their own: the step never waits
         self.core = VehicleCore(self.simulation.executor, declare_config(self, VehicleConfig),
                                 declare_config(self, ObstacleConfig))
+        self.core.retimer.start()   # set_velocity answers before its re-plan (1.4.32)
         self.motion, self.goals = Plane(self, "motion"), Plane(self, "goals")
         serve_operations(self, self.motion, self.core, OPERATIONS, write_success)
         self.wait_motion = WaitMotionServer(self.goals, self.core, declare_config(self, WaitConfig))

@@ -27,6 +27,7 @@ from acti_motion.vehicle.paths import Odometry
 from acti_motion.vehicle.planning import (LOOKAHEAD_GROWTH, LOOKAHEAD_STEPS, PAUSED, PAUSED_DRIVE,
                                           Planning)
 from acti_motion.vehicle.refusals import bounded_pair
+from acti_motion.vehicle.retiming import Retimer
 from acti_motion.vehicle.sensing import Sensing
 from acti_motion.vehicle.states import VehicleState
 from acti_sim.battery import Battery, BatteryModel, VoltageLevel
@@ -90,6 +91,7 @@ class VehicleCore(Control, Planning, Sensing, Obstacles):
         self._stick = (0.0, 0.0)             # the last Joy sample's deflections that drove the base
         self._dt = executor.dt
         self._init_obstacles(obstacles or ObstacleConfig(), world)
+        self.retimer = Retimer(self._retime_to_settings)     # its thread: retimer.start()
         warm_up(self._limits())           # the first request does not pay for first-use costs
         executor.before_step(self._sense)
 

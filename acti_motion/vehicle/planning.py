@@ -1,5 +1,5 @@
 """The planning path of the base: every move, the settings that re-time or re-frame the motions
-(set_velocity, set_acceleration, set_position), the joystick and its input. Each operation runs
+(set_velocity's re-plan, set_acceleration, set_position), the joystick and its input. Each operation runs
 on the caller's thread (the node's motion plane) under the `planning` lock (`@planned`;
 joy_input takes it itself), one at a time, and plans under no lock that the control operations
 or the simulation take, so that a plan taking milliseconds never delays stop, pause, a getter
@@ -14,18 +14,19 @@ from contextlib import contextmanager
 from typing import Any, Callable, Iterator
 
 from acti_motion.executor import STALE, Device
-from acti_motion.replies import Refused, finite_number
+from acti_motion.replies import Refused, Reply, finite_number
 from acti_motion.vehicle.alarms import AlarmCode
 from acti_motion.vehicle.cruise import CruiseMotion, transition_to
 from acti_motion.vehicle.paths import (Path, Pose2D, TrackedBaseMotion, arc, line, straight_to, turn,
                                        velocity_path)
-from acti_motion.vehicle.refusals import (Discarded, VehicleRefused, bounded_pair, finite_pose, invalid,
+from acti_motion.vehicle.refusals import (Discarded, VehicleRefused, bounded_pair, command, finite_pose, invalid,
                                           planned, si_pair)
 from acti_motion.vehicle.sensing import VELOCITY_DRIVEN
 from acti_motion.vehicle.states import READY_ONLY, SERVO_ON, STATE_STRINGS, VehicleState
 
 LOOKAHEAD_STEPS = 2          # control periods ahead of now that an edit planned off-lock splices in …
 LOOKAHEAD_GROWTH = 4         # … times this for each attempt the device outran
+RETIME_TRIES = 3             # re-plans of a new velocity setting before the moves keep their timing
 
 
 PAUSED = object()       # look of a take-over: the base is paused, the command queues for resume
@@ -42,15 +43,36 @@ class Planning:
     device: Device
 
     # --- settings that re-time or re-frame the motions --------------------------------------
-    @planned
-    def set_velocity(self, vel: Any) -> None:
-        """Within [velocity_min, limit]. A moving base changes speed smoothly (at the
-        acceleration setting) to match; queued moves take it too. Jogs keep their velocities (the
-        command's own); a joystick drive scales to it (full stick = the setting)."""
-        value = bounded_pair(vel, *self.velocity_bounds, "vel", ("mm/s", "degree/s"))
-        self._retime(value, self.acceleration)
-        self.velocity = value
-        self._rescale_joystick()
+    def set_velocity(self, vel: Any) -> Reply:
+        """Within [velocity_min, limit]; answered once the value is checked and set, as 1.4.32
+        answers (真：引数で指定した値が正常に設定された). A moving base then changes speed smoothly
+        (at the acceleration setting) to match; queued moves take it too (移動中に実行すると，
+        移動速度を連続かつ動的に変化させて設定値に一致させます): the re-plan runs after the answer
+        (`retiming`), so the caller never waits for it. Jogs keep their velocities (the command's
+        own); a joystick drive scales to it (full stick = the setting)."""
+        reply = self._set_velocity(vel)
+        if reply.ok:
+            self.retimer.request()
+        return reply
+
+    @command
+    def _set_velocity(self, vel: Any) -> None:
+        self.velocity = bounded_pair(vel, *self.velocity_bounds, "vel", ("mm/s", "degree/s"))
+
+    def _retime_to_settings(self) -> None:
+        """The re-plan a new velocity setting asks (the retimer's): the running and queued moves
+        re-timed to the settings as they are now (a move that outran the plan is planned again),
+        and a joystick drive rescaled."""
+        with self.planning_operation():
+            for _ in range(RETIME_TRIES):
+                try:
+                    self._retime(self.velocity, self.acceleration)
+                    break
+                except VehicleRefused:
+                    continue            # the base outran the plan: plan again from where it is
+            else:
+                raise RuntimeError(f"the base outran {RETIME_TRIES} re-plans")
+            self._rescale_joystick()
 
     @planned
     def set_acceleration(self, accel: Any) -> None:

@@ -47,6 +47,8 @@ def _operation(clears_warnings: bool, planning: bool = False) -> Callable[[Calla
     stop, pause, the getters and the simulation never wait for a plan, and are marked `plans`
     (their node serves them on the motion plane: one waits there for another's plan)."""
     def decorate(fn: Callable[..., Any]) -> Callable[..., Any]:
+        name = fn.__name__.lstrip("_")      # the checking half of an operation (_set_velocity) names it
+
         @functools.wraps(fn)
         def recorded(self: "VehicleCore", *args: Any, **kwargs: Any) -> Any:
             with (self.planning_operation() if planning else self.lock):
@@ -55,10 +57,10 @@ def _operation(clears_warnings: bool, planning: bool = False) -> Callable[[Calla
                 except Refused as r:
                     if r.code != ReturnCode.OK:
                         code = getattr(r, "alarm", None) or WARNING_FOR.get(r.code, AlarmCode.INVALID_VALUE)
-                        self.alarms.raise_(code, f"{fn.__name__}: {r.comment}", Kind.COMMAND)
+                        self.alarms.raise_(code, f"{name}: {r.comment}", Kind.COMMAND)
                     raise
                 except (ArithmeticError, ValueError, TypeError, IndexError) as e:
-                    comment = f"{fn.__name__} could not be carried out ({type(e).__name__}: {e})"
+                    comment = f"{name} could not be carried out ({type(e).__name__}: {e})"
                     self.alarms.raise_(AlarmCode.INVALID_VALUE, comment, Kind.COMMAND)
                     raise invalid(comment) from None
                 if clears_warnings:
