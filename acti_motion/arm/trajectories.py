@@ -27,7 +27,7 @@ import numpy as np
 import pinocchio as pin
 import toppra as ta     # at start-up: the import takes most of a second, never in a request
 from scipy.interpolate import PPoly
-from scipy.linalg import solve_banded
+from scipy.linalg import lapack
 
 from acti_motion.arm.kinematics import (ArmKinematics, Unreachable, exp3_many, rotate_many,
                                         wrap)
@@ -51,7 +51,6 @@ GRID_STEP_MM = 15.0       # TOPP-RA grid intervals: at most this much of the pat
 GRID_STEP_RAD = math.radians(3.0)   # and of a turn or of the joints' travel
 SAMPLE_FLOOR = 4          # least intervals of the IK samples of a CP path (more where it strays)
 ELBOW_GRID_FLOOR = 4      # least intervals of the grid the elbow is carried on along a CP path
-DENSE_SPLINE = 16         # splines through up to this many points are solved densely
 NO_TURN = 1e-12           # rad: a line's rotation below this is rounding (R1·R0ᵀ of equal R)
 
 
@@ -92,13 +91,15 @@ def not_a_knot_spline(xs: np.ndarray, ys: np.ndarray) -> PPoly:
 
 def not_a_knot_coefficients(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
     """The coefficients (4 × pieces × dof, highest power first, as PPoly's) of
-    `not_a_knot_spline`. A few points (a short line) are solved densely: LAPACK's banded
-    solver through scipy costs more than numpy's dense one up to ~16."""
+    `not_a_knot_spline`. The tridiagonal system goes to LAPACK's banded solver (gbsv) as
+    scipy.linalg.solve_banded hands it over, without that function's checks (most of its
+    cost on a short line's few points)."""
     dx = xs[1:] - xs[:-1]
     slope = (ys[1:] - ys[:-1]) / dx[:, None]
     h = dx.tolist()
     n = len(xs)
-    A = np.zeros((3, n))                    # banded: upper, main, lower diagonal
+    band = np.zeros((4, n))       # gbsv's layout: a row for its fill-in, upper, main, lower
+    A = band[1:]
     A[1, 1:-1] = 2.0 * (dx[:-1] + dx[1:])
     A[0, 2:] = dx[:-1]
     A[2, :-2] = dx[1:]
@@ -110,10 +111,9 @@ def not_a_knot_coefficients(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
     d = h[-1] + h[-2]
     A[1, -1], A[2, -2] = h[-2], d
     b[-1] = (h[-1] ** 2 * slope[-2] + (2 * d + h[-1]) * h[-2] * slope[-1]) / d
-    if n <= DENSE_SPLINE:
-        ds = np.linalg.solve(np.diag(A[1]) + np.diag(A[0, 1:], 1) + np.diag(A[2, :-1], -1), b)
-    else:
-        ds = solve_banded((1, 1), A, b, overwrite_ab=True, overwrite_b=True, check_finite=False)
+    _, _, ds, info = lapack.dgbsv(1, 1, band, b, overwrite_ab=True, overwrite_b=True)
+    if info:
+        raise np.linalg.LinAlgError(f"singular spline system (gbsv info {info})")
     dxc = dx[:, None]
     t = (ds[:-1] + ds[1:] - 2.0 * slope) / dxc
     c = np.empty((4, n - 1, ys.shape[1]))
