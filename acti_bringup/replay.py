@@ -20,8 +20,7 @@ import sys
 import rclpy
 
 from acti_bringup.record import wanted_topics
-from acti_bringup.recording.replay import (RequestReplay, is_hidden, recorded_calls,
-                                           republish)
+from acti_bringup.recording.replay import RequestReplay, is_hidden, republish
 from acti_bringup.serving.spinning import init, stop_requested
 from acti_record.calls import ABS_TOL
 from acti_record.reading import BadRecording, read_recording
@@ -67,11 +66,11 @@ def main(args: list[str] | None = None) -> None:
     node = rclpy.create_node("acti_replay")
     try:
         if options.requests:
-            calls = recorded_calls(contents)
-            print(f"replaying {len(calls)} calls of {options.path}")
-            found = RequestReplay(node, calls, options.rate, options.timeout, options.tolerance,
-                                  stop_requested).run()
-            print(f"{len(calls)} calls, {len(found)} differences")
+            replay = RequestReplay(node, contents, options.rate, options.timeout,
+                                   options.tolerance, stop_requested)
+            print(f"replaying {len(replay.calls)} calls of {options.path}")
+            found = replay.run()
+            print(f"{len(replay.calls)} calls, {len(found)} differences")
             status = 1 if found or stop_requested() else 0
         else:
             wanted = wanted_topics(options.topics) if options.topics else \

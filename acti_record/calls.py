@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Iterable
+from typing import Any, Iterable, Iterator
 
 EVENT_TOPIC_SUFFIX = "/_service_event"
 EVENT_TYPE_SUFFIX = "_Event"
@@ -62,32 +62,36 @@ def pair(events: Iterable[Event]) -> list[Call]:
     return sorted(calls.values(), key=lambda c: c.request_ns)
 
 
-def answered_before(calls: list[Call]) -> list[list[int]]:
-    """For each call, the earlier calls whose answer came before its request in the recording:
-    their replayed answers must come before it is sent (a client that waited for an answer
-    before its next call waits in the replay too)."""
-    return [[j for j in range(i) if calls[j].response_ns is not None
-             and calls[j].response_ns <= call.request_ns]
-            for i, call in enumerate(calls)]
-
-
-def differences(recorded: Any, replayed: Any, path: str = "response",
-                abs_tol: float = ABS_TOL) -> list[str]:
-    """Where two plain values (dicts, lists, numbers, strings) differ, one line each; the
-    NORMALISED fields are not compared, floating-point numbers within REL_TOL or abs_tol."""
+def leaves(recorded: Any, replayed: Any, path: str = "response"
+           ) -> Iterator[tuple[str, Any, Any]]:
+    """The pairs of plain values (dicts, lists, numbers, strings) to compare, with their path:
+    the NORMALISED fields left out; lists of another length and other values whole."""
     if isinstance(recorded, dict) and isinstance(replayed, dict):
-        out = []
         for key in dict.fromkeys([*recorded, *replayed]):
             if key not in NORMALISED:
-                out += differences(recorded.get(key), replayed.get(key), f"{path}.{key}", abs_tol)
-        return out
-    if isinstance(recorded, list) and isinstance(replayed, list) and len(recorded) == len(replayed):
-        return [line for i, (a, b) in enumerate(zip(recorded, replayed))
-                for line in differences(a, b, f"{path}[{i}]", abs_tol)]
-    if isinstance(recorded, float) or isinstance(replayed, float):
-        if isinstance(recorded, (int, float)) and isinstance(replayed, (int, float)) and \
-                math.isclose(recorded, replayed, rel_tol=REL_TOL, abs_tol=abs_tol):
-            return []
-    elif recorded == replayed:
-        return []
-    return [f"{path}: recorded {recorded!r}, replayed {replayed!r}"]
+                yield from leaves(recorded.get(key), replayed.get(key), f"{path}.{key}")
+    elif isinstance(recorded, list) and isinstance(replayed, list) and \
+            len(recorded) == len(replayed):
+        for i, (a, b) in enumerate(zip(recorded, replayed)):
+            yield from leaves(a, b, f"{path}[{i}]")
+    else:
+        yield path, recorded, replayed
+
+
+def _measured(recorded: Any, replayed: Any) -> bool:
+    return (isinstance(recorded, float) or isinstance(replayed, float)) and \
+        all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (recorded, replayed))
+
+
+def differences(recorded: Any, replayed: Any, abs_tol: float = ABS_TOL) -> list[str]:
+    """Where two plain values differ, one line each: floating-point numbers (measured) within
+    REL_TOL or abs_tol, everything else (states, flags, ids, texts) exactly."""
+    return [f"{path}: recorded {a!r}, replayed {b!r}" for path, a, b in leaves(recorded, replayed)
+            if not (math.isclose(a, b, rel_tol=REL_TOL, abs_tol=abs_tol) if _measured(a, b)
+                    else a == b)]
+
+
+def largest_deviation(recorded: Any, replayed: Any) -> float:
+    """The largest difference of two measured numbers (0 when none differ)."""
+    return max((abs(a - b) for _, a, b in leaves(recorded, replayed) if _measured(a, b)),
+               default=0.0)

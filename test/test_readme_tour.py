@@ -50,9 +50,11 @@ def first_bash_block(path: str, heading: str) -> str:
     return text.split(f"\n{heading}\n", 1)[1].split("```bash\n", 1)[1].split("```", 1)[0]
 
 
-def bounded(script: str) -> str:
-    """The command that runs until Ctrl-C, made to end by itself."""
-    return re.sub(r"^ros2 topic pub ", "ros2 topic pub -t 10 ", script, flags=re.M)
+def bounded(script: str, listeners: int | None = None) -> str:
+    """The command that runs until Ctrl-C, made to end by itself; with `listeners`, its first
+    message sent once that many subscriptions match (one matched later misses the first)."""
+    wait = f"-w {listeners} " if listeners else ""
+    return re.sub(r"^ros2 topic pub ", f"ros2 topic pub -t 10 {wait}", script, flags=re.M)
 
 
 def commands(block: str) -> list[Command]:
@@ -78,6 +80,13 @@ def commands(block: str) -> list[Command]:
         after_command = True
         i += 1
     return found
+
+
+def pasted_tour() -> list[Command]:
+    """The quick tour's commands, then a read of where the jog took the base (for its check)."""
+    tour = commands(first_bash_block("README.md", "## Quick tour"))
+    assert tour[0].text == "source tools/env.sh", tour[0]
+    return tour + [Command(WHERE_IT_IS)]
 
 
 def run_pasted(script: str) -> str:
@@ -135,9 +144,7 @@ PROSE_CHECKS = {"drives the base while it publishes": moved_by_hand}
 
 
 def test_the_quick_tour_prints_what_its_comments_say(robot):
-    tour = commands(first_bash_block("README.md", "## Quick tour"))
-    assert tour[0].text == "source tools/env.sh", tour[0]
-    tour.append(Command(WHERE_IT_IS))          # where the jog took the base, for its check
+    tour = pasted_tour()
     script = "\n".join(f"echo '{MARK}{n}'\n{bounded(c.text)}" for n, c in enumerate(tour))
     outputs = re.split(rf"^{MARK}\d+\n", run_pasted(script), flags=re.M)[1:]
     assert len(outputs) == len(tour)

@@ -1,8 +1,8 @@
-"""Recording and replaying the job over DDS: the quick tour's calls recorded by the job's own
-`record` parameter and replayed against a fresh job with every answer equal; topics read back
-with rosbags as they were published and republished with their timing; a recorder killed with
--9 while both devices move leaves a file that reads up to its last flush and is reindexed
-whole for rosbags; what is not a recording is refused in one line."""
+"""Recording and replaying the job over DDS: the README's quick tour, pasted as it is, recorded
+by the job's own `record` parameter and its calls replayed against a fresh job with every
+answer equal; topics read back with rosbags as they were published and republished with their
+timing; a recorder killed with -9 while both devices move leaves a file that reads up to its
+last flush and is reindexed whole for rosbags; what is not a recording is refused in one line."""
 import os
 import signal
 import subprocess
@@ -16,16 +16,13 @@ from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
 from std_msgs.msg import String
 
-from acti_bringup.harness import (ROOT, Actions, NodeProcess, both_moving, keep_moving,
-                                  start_moving, wait_until)
-from acti_msgs import srv
-from acti_msgs.action import Move, RunProgram, VehicleWaitMotion, WaitMotion
-from acti_msgs.msg import CarPosWithElbow, VehiclePosition
+from acti_bringup.harness import (ROOT, NodeProcess, both_moving, keep_moving, start_moving,
+                                  wait_until)
+from acti_bringup.recording.replay import recorded_calls
 from acti_record.reading import BadRecording, read_recording
 from ros_harness import TEST_RATE
+from test_readme_tour import bounded, pasted_tour, run_pasted
 
-ARM, BASE = "/acti_middle_node/", "/vehicle_node/"
-PROGRAM = "30 JSPEED DROP Ar[R8 10 30 0 -60 0 60 0] ADRIVE DROP -1 $WAIT"
 LASTING = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
@@ -46,59 +43,33 @@ def recorder(path: str, *topics: str) -> subprocess.Popen:
 
 
 
-def tour(ros) -> int:
-    """The README quick tour's calls, each read taken at rest (a read while moving, or while the
-    joints settle after a move, depends on timing): the arm's after the base's moves; the
-    number of calls made, a goal's two (its goal and its result) counted."""
-    def call(srv_type, name, **fields):
-        reply = ros.call(srv_type, name, **fields)
-        assert getattr(reply, "success", True), reply
-        assert getattr(getattr(reply, "return_id", None), "id", 0) == 0, reply
+@pytest.fixture(scope="module")
+def recorded_tour(tmp_path_factory):
+    """The README's quick tour pasted as it is (the jog bounded as test_readme_tour bounds it,
+    sent once the job and its recorder both listen) on a job at real time that records itself;
+    the job then stopped with Ctrl-C. (the file, what the tour printed, the folder)"""
+    folder = tmp_path_factory.mktemp("tour")
+    path = str(folder / "tour.mcap")
+    first = job(folder, "first", "real_time_factor:=1.0", f"record:={path}")
+    try:
+        printed = run_pasted("\n".join(bounded(c.text, listeners=2) for c in pasted_tour()))
+    finally:
+        stopped = first.stop()
+    assert stopped in (0, -signal.SIGINT) and "Traceback" not in first.log(), first.log()
+    return path, printed, folder
 
-    def finish(actions, **goal):
-        status, _ = actions.result(actions.send(**goal))
-        assert status == 4          # SUCCEEDED
-    arm_wait = Actions(ros, WaitMotion, ARM + "wait_motion")
-    base_wait = Actions(ros, VehicleWaitMotion, BASE + "wait_motion")
-    call(srv.ServoON, ARM + "servo_on")
-    call(srv.SetSpeedJoint, ARM + "set_speed_joint", spd_ratio=50)
-    call(srv.MovePTPJointAbs, ARM + "move_ptp_joint_abs",
-         joint_points=[10.0, 20.0, 30.0, -40.0, 50.0, 60.0, 70.0])
-    finish(arm_wait, motion_id=0)
-    call(srv.VehicleSetPower, BASE + "set_power", on_off=True)
-    call(srv.VehicleSetServo, BASE + "set_servo", on_off=True)
-    call(srv.VehicleGetState, BASE + "get_state")
-    call(srv.VehicleMoveForward, BASE + "move_forward", x=500.0)
-    finish(base_wait, motion_id=0)
-    call(srv.VehicleMoveTurn, BASE + "move_turn", theta=90.0)
-    finish(base_wait, motion_id=0)
-    call(srv.VehicleMoveLinearAbs, BASE + "move_linear_abs",
-         pos=VehiclePosition(x=1000.0, y=500.0, theta=0.0))
-    finish(base_wait, motion_id=0)
-    call(srv.VehicleGetPosition, BASE + "get_position")
-    call(srv.VehicleGetActiveAlarm, BASE + "get_active_alarm", num_of_alarm=5)
-    call(srv.GetState, ARM + "get_state")          # the arm's reads, seconds after it stopped
-    call(srv.GetFeedbackPosJoint, ARM + "get_feedback_pos_joint")
-    call(srv.SetSpeedCartesian, ARM + "set_speed_cartesian", spd_ratio=50)
-    call(srv.MoveLinearCartesianRel, ARM + "move_linear_cartesian_rel", car_point=CarPosWithElbow(
-        car_pos=[1.0, 0.0, 0.0, 100.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, -150.0], elbow=0.0))
-    finish(arm_wait, motion_id=0)
-    finish(Actions(ros, Move, ARM + "move"), kind="move_ptp_joint_abs",
-           joint_points=[0.0, 30.0, 0.0, -60.0, 0.0, 60.0, 0.0])
-    finish(Actions(ros, RunProgram, ARM + "run_program"), text=PROGRAM)
-    return 15 + 2 * 6
+
+def test_the_quick_tour_is_recorded_call_by_call(recorded_tour):
+    path, printed, _ = recorded_tour
+    calls = [c.service for c in recorded_calls(read_recording(path))]
+    assert len(calls) == printed.count("requester: making request") + 2 * printed.count(
+        "Sending goal"), (calls, printed)      # a goal: its goal and its result
 
 
 def test_the_recorded_tour_replayed_against_a_fresh_job_answers_every_call_equally(
-        ros, tmp_path):
-    path = str(tmp_path / "tour.mcap")
-    first = job(tmp_path, "first", f"record:={path}")
-    try:
-        made = tour(ros)
-    finally:
-        assert first.stop() in (0, -signal.SIGINT), first.log()
-    assert "Traceback" not in first.log(), first.log()
-    fresh = job(tmp_path, "fresh")
+        recorded_tour):
+    path, _, folder = recorded_tour
+    fresh = job(folder, "fresh", "real_time_factor:=1.0")
     try:
         replayed = run("acti_bringup.replay", path, "--requests")
     finally:
@@ -106,7 +77,7 @@ def test_the_recorded_tour_replayed_against_a_fresh_job_answers_every_call_equal
     out = replayed.stdout + replayed.stderr
     assert replayed.returncode == 0, out
     calls = int(out.split(" calls, ")[0].rsplit("\n", 1)[-1])
-    assert calls >= made and out.rstrip().endswith(f"{calls} calls, 0 differences"), out
+    assert out.rstrip().endswith(f"{calls} calls, 0 differences"), out
     assert out.count(": equal") == calls, out       # every answer was compared
 
 

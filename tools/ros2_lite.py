@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import array
 import importlib
+import math
 import os
 import signal
 import sys
@@ -148,8 +149,12 @@ def topic_pub(node: Node, a: argparse.Namespace) -> None:
     msg = request(cls, a.values)
     pub = node.create_publisher(cls, a.topic, 10)
     times = 1 if a.once else a.times
-    deadline = time.monotonic() + MATCH_WAIT_S   # else the first message may reach no one
-    while pub.get_subscription_count() == 0 and time.monotonic() < deadline:
+    # else the first message may reach no one: one subscription, for MATCH_WAIT_S at most, or
+    # as many as -w says, as long as it takes (the real CLI's -w)
+    wanted = 1 if a.wait_matching_subscriptions is None else a.wait_matching_subscriptions
+    deadline = time.monotonic() + (MATCH_WAIT_S if a.wait_matching_subscriptions is None
+                                   else math.inf)
+    while pub.get_subscription_count() < wanted and time.monotonic() < deadline:
         rclpy.spin_once(node, timeout_sec=0.05)
     print("publisher: beginning loop")
     sent = 0
@@ -315,6 +320,7 @@ def _topic_parsers(groups: Any) -> None:
     pub.add_argument("-r", "--rate", type=float, default=1.0)
     pub.add_argument("-1", "--once", action="store_true")
     pub.add_argument("-t", "--times", type=int, default=None)
+    pub.add_argument("-w", "--wait-matching-subscriptions", type=int, default=None)
     pub.set_defaults(run=topic_pub)
     echo = topic.add_parser("echo")
     echo.add_argument("topic"), echo.add_argument("type", nargs="?")

@@ -4,7 +4,8 @@ rclpy received, unconverted, to a recording (`acti_record.writing`).
 
 Topics are discovered from the graph every DISCOVERY_PERIOD_S; each is subscribed with the QoS
 its publishers offer (reliable and transient-local only when all of them are, as rosbag2 does),
-and recorded with their QoS profiles and type hash."""
+and recorded with their QoS profiles and type hash. A topic that is only listened to so far (a
+command topic: cmd_vel) is subscribed at once to match any publisher its listeners can hear."""
 from __future__ import annotations
 
 import time
@@ -49,28 +50,42 @@ class Recorder:
 
     def _subscribe(self, name: str, type_name: str) -> None:
         msg_class = type_class(type_name)
-        publishers = [p for p in self.node.get_publishers_info_by_topic(name)
-                      if p.topic_type == type_name]
-        if not publishers:
-            return                               # only subscribers so far: try again later
+        publishers = self._publishers(name, type_name)
+        if publishers:
+            qos = _subscription_qos(publishers)
+        else:
+            # a topic the job listens to that nobody publishes yet (cmd_vel …): subscribed now,
+            # so that the first messages of a publisher that comes later are recorded too (the
+            # graph is looked at every DISCOVERY_PERIOD_S: a jog would lose its first half second)
+            listeners = [s.qos_profile for s in self.node.get_subscriptions_info_by_topic(name)
+                         if s.topic_type == type_name]
+            if not listeners:
+                return
+            qos = _listening_qos(listeners)
         try:
             definition = full_text(type_name, share_dir)
         except DefinitionNotFound as e:
             self.node.get_logger().warning(f"{name}: no definition of {type_name} ({e}): "
                                            "recorded without one")
             definition = ""
-        topic = Topic(name, type_name, definition,
-                      tuple(_profile(p.qos_profile) for p in publishers),
-                      str(publishers[0].topic_type_hash))
         write = self.recording.write
+        topic: list[Topic] = []          # made at the first message, with its publishers
 
         def received(data: bytes, info: Any) -> None:
             now = time.time_ns()
-            write(topic, data, now, info.get("source_timestamp", now) if isinstance(info, dict)
-                  else now)
+            if not topic:
+                offered = publishers or self._publishers(name, type_name)
+                topic.append(Topic(name, type_name, definition,
+                                   tuple(_profile(p.qos_profile) for p in offered),
+                                   str(offered[0].topic_type_hash) if offered else ""))
+            write(topic[0], data, now, info.get("source_timestamp", now)
+                  if isinstance(info, dict) else now)
         self._subscriptions[name] = self.node.create_subscription(
-            msg_class, name, received, _subscription_qos(publishers), raw=True,
-            event_callbacks=NO_EVENTS)
+            msg_class, name, received, qos, raw=True, event_callbacks=NO_EVENTS)
+
+    def _publishers(self, name: str, type_name: str) -> list:
+        return [p for p in self.node.get_publishers_info_by_topic(name)
+                if p.topic_type == type_name]
 
 
 def _subscription_qos(publishers: list) -> QoSProfile:
@@ -81,6 +96,15 @@ def _subscription_qos(publishers: list) -> QoSProfile:
     return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=RECEIVE_DEPTH,
                       reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
                       durability=DurabilityPolicy.TRANSIENT_LOCAL if lasting else DurabilityPolicy.VOLATILE)
+
+
+def _listening_qos(listeners: list[QoSProfile]) -> QoSProfile:
+    """Matches every publisher the listeners can hear: reliable when they all ask for it (then
+    every publisher they hear offers it), else best effort; volatile."""
+    reliable = all(q.reliability == ReliabilityPolicy.RELIABLE for q in listeners)
+    return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=RECEIVE_DEPTH,
+                      reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
+                      durability=DurabilityPolicy.VOLATILE)
 
 
 def _profile(q: QoSProfile) -> dict:

@@ -4,6 +4,8 @@ one (`acti_record.calls`)."""
 from __future__ import annotations
 
 import array
+import math
+import statistics
 import time
 from typing import Any, Callable
 
@@ -12,15 +14,23 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
+from rosgraph_msgs.msg import Clock
 
+from acti_bringup.recording.introspection import EVENT_QOS
 from acti_bringup.recording.types import type_class
 from acti_bringup.serving.adapter import CLIENT_QOS
-from acti_record.calls import Call, Event, answered_before, differences, pair, service_of
-from acti_record.reading import Channel, Contents
+from acti_record.calls import (EVENT_TOPIC_SUFFIX, EVENT_TYPE_SUFFIX, REQUEST_RECEIVED,
+                               RESPONSE_SENT, Call, Event, differences, largest_deviation,
+                               pair, service_of)
+from acti_record.reading import Channel, Contents, Message
+from acti_record.timing import ClockMap, Plan, SpeedTrack
 
 SERVICE_WAIT_S = 30.0
 REPUBLISH_DEPTH = 1000
 ACKED_WAIT_S = 5.0
+MATCH_WAIT_S = 10.0       # for the job's clock, its service events, the command topics' listeners
+EVENT_WAIT_S = 5.0        # for the job's events of the last calls, after their answers
+CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
 
 
 def plain(value: Any) -> Any:
@@ -107,42 +117,70 @@ def recorded_calls(contents: Contents) -> list[Call]:
 
 
 class RequestReplay:
-    """Send the calls to the running job in their recorded order and timing (scaled by 1/rate),
-    and compare each answer with the recorded one."""
+    """Send the recorded calls, and the messages of the recording's command topics, to the
+    running job in their recorded order and timing (`acti_record.timing.Plan`: on the job's
+    clock, scaled by 1/rate) and compare each answer with the recorded one, measured numbers
+    within the tolerance and how far the replay's timing errors may have moved the device."""
 
-    def __init__(self, node: Node, calls: list[Call], rate: float, answer_timeout_s: float,
+    def __init__(self, node: Node, contents: Contents, rate: float, answer_timeout_s: float,
                  tolerance: float, stopped: Callable[[], bool],
                  say: Callable[[str], None] = print) -> None:
-        self.node, self.calls, self.rate, self.timeout = node, calls, rate, answer_timeout_s
-        self.tolerance = tolerance
+        self.node, self.contents, self.rate = node, contents, rate
+        self.timeout, self.tolerance = answer_timeout_s, tolerance
         self.stopped, self.say = stopped, say
+        self.calls = recorded_calls(contents)
         self.executor = SingleThreadedExecutor()
         self.executor.add_node(node)
         self.clients: dict[str, Any] = {}
         self.differences: list[str] = []
+        self.commands: list[Message] = []
+        self.clock = recorded_clock(contents)     # the recorded job's simulated time
+        self.job_clock = ClockMap()
+        self.taken: dict[str, list[tuple[int, tuple]]] = {}   # the job's requests taken
+        self.answered: dict[tuple, int] = {}                   # (service, client, seq): stamp
 
     def run(self) -> list[str]:
-        """The differences found (a line each); also those said as they are found."""
+        """The differences found (a line each; also said, as is every call's outcome)."""
         if not self._clients_ready():
             return self.differences
-        must_wait = answered_before(self.calls)
-        futures: dict[int, tuple[Any, float]] = {}
-        answered: set[int] = set()
-        start, t0 = time.monotonic(), self.calls[0].request_ns if self.calls else 0
+        publishers, devices = self._command_topics()
+        self._watch_the_job()
+        plan = Plan(self.calls, self.commands, lambda c: device_of_service(c.service), devices,
+                    self.clock)
+        sent: dict[int, int] = {}                       # event: when this replay made it
+        answers: dict[int, Any] = {}
+        pending: dict[int, Any] = {}
+        latency: list[int] = []                         # a request sent until the job took it
         following = 0
-        while (following < len(self.calls) or futures) and not self.stopped():
-            now = time.monotonic()
-            while following < len(self.calls) and set(must_wait[following]) <= answered \
-                    and now >= start + (self.calls[following].request_ns - t0) / 1e9 / self.rate:
-                call = self.calls[following]
-                futures[following] = (self.clients[call.service].call_async(call.request), now)
+        while (following < len(plan.inputs) or pending) and not self.stopped():
+            while following < len(plan.inputs) and plan.waits[following] <= set(answers):
+                kind, k = plan.inputs[following]
+                early = statistics.median(latency) if kind == "call" and latency else 0
+                due = plan.due_ns(following, self._job_times(plan, sent), self.job_clock,
+                                  self.rate)
+                if self.job_clock.sim_at(time.time_ns()) < due - early:
+                    break
+                sent[plan.event_of[following]] = time.time_ns()
+                if kind == "call":
+                    pending[k] = self.clients[self.calls[k].service].call_async(
+                        self.calls[k].request)
+                else:
+                    publishers[self.commands[k].channel.topic].publish(self.commands[k].data)
                 following += 1
-            self.executor.spin_once(timeout_sec=0.01)
-            for i, (future, sent) in list(futures.items()):
-                if future.done() or time.monotonic() - sent > self.timeout:
-                    del futures[i]
-                    answered.add(i)
-                    self._compare(i, future.result() if future.done() else None)
+            self.executor.spin_once(timeout_sec=0.001)
+            for k, future in list(pending.items()):
+                asked = sent[plan.request_event[k]]
+                if future.done() or time.time_ns() - asked > self.timeout * 1e9:
+                    del pending[k]
+                    answers[k] = future.result() if future.done() else None
+                    if plan.answer_event[k] is not None:
+                        sent[plan.answer_event[k]] = time.time_ns()
+                    taken = self._taken(plan, k)
+                    if taken is not None:
+                        latency.append(taken[0] - asked)
+        _wait(self.executor, lambda: all(self._taken(plan, k) for k in range(len(self.calls))),
+              EVENT_WAIT_S)
+        self._compare_all(plan, answers, self._job_times(plan, sent))
         self.executor.remove_node(self.node)
         return self.differences
 
@@ -159,20 +197,167 @@ class RequestReplay:
                 return False
         return True
 
-    def _compare(self, index: int, answer: Any) -> None:
-        call = self.calls[index]
-        what = f"#{index + 1} {call.service}"
+    def _command_topics(self) -> tuple[dict[str, Any], dict[str, str]]:
+        """The recorded topics the running job listens to and does not publish itself (commands
+        from outside: cmd_vel …): a publisher each, and the node listening (the device)."""
+        publishers, devices = {}, {}
+        for channel in self.contents.channels:
+            if is_hidden(channel.topic):
+                continue
+            listeners = [s for s in self.node.get_subscriptions_info_by_topic(channel.topic)
+                         if s.node_name != self.node.get_name()]
+            if listeners and not self.node.get_publishers_info_by_topic(channel.topic):
+                publishers[channel.topic] = self.node.create_publisher(
+                    type_class(channel.type), channel.topic, _qos(channel))
+                devices[channel.topic] = node_path(listeners[0].node_namespace,
+                                                   listeners[0].node_name)
+        self.commands = [m for m in self.contents.messages if m.channel.topic in publishers]
+        _wait(self.executor, lambda: all(p.get_subscription_count()
+                                         for p in publishers.values()), MATCH_WAIT_S)
+        return publishers, devices
+
+    def _watch_the_job(self) -> None:
+        """Subscribe to the job's clock and to the events of the services called (when the job
+        took each request, when it answered), and wait until they are heard."""
+        watched = []
+        clocks = [c.topic for c in self.contents.channels if c.type == CLOCK_TYPE]
+        if clocks:
+            watched.append(self.node.create_subscription(Clock, clocks[0], self._on_clock, 100))
+        for service, service_type in {(c.service, c.service_type) for c in self.calls}:
+            watched.append(self.node.create_subscription(
+                type_class(service_type + EVENT_TYPE_SUFFIX), service + EVENT_TOPIC_SUFFIX,
+                lambda event, name=service: self._on_event(name, event), EVENT_QOS))
+        _wait(self.executor, lambda: all(w.get_publisher_count() for w in watched) and
+              (not clocks or len(self.job_clock.walls) > 1), MATCH_WAIT_S)
+
+    def _on_clock(self, message: Clock, info: Any) -> None:
+        self.job_clock.add(info["source_timestamp"], _ns(message.clock))
+
+    def _on_event(self, service: str, event: Any) -> None:
+        info = event.info
+        key = (service, bytes(info.client_gid), info.sequence_number)
+        if info.event_type == REQUEST_RECEIVED:
+            self.taken.setdefault(service, []).append((_ns(info.stamp), key))
+        elif info.event_type == RESPONSE_SENT:
+            self.answered[key] = _ns(info.stamp)
+
+    def _taken(self, plan: Plan, k: int) -> tuple[int, tuple] | None:
+        """When the job took call k's request, and its key (the k-th call of its service)."""
+        taken = self.taken.get(self.calls[k].service, [])
+        nth = plan.nth_of_service[k]
+        return taken[nth] if nth < len(taken) else None
+
+    def _job_times(self, plan: Plan, sent: dict[int, int]) -> dict[int, int]:
+        """Each event made so far on the job's wall clock: a request when the job took it and
+        an answer when it sent it (by the job's events), a message when it was published."""
+        times = dict(sent)
+        for k in range(len(self.calls)):
+            taken = self._taken(plan, k)
+            if taken is not None:
+                times[plan.request_event[k]] = taken[0]
+                answer = plan.answer_event[k]
+                if answer in times and taken[1] in self.answered:
+                    times[answer] = self.answered[taken[1]]
+        return times
+
+    def _compare_all(self, plan: Plan, answers: dict[int, Any], job_ns: dict[int, int]) -> None:
+        errors = plan.errors_s(job_ns, self.job_clock, self.rate)
+        speeds = recorded_speeds(self.contents, self.clock)
+        margin_s = self.clock.period_ns() / 1e9
+        allowed = plan.allowances(errors, lambda device, t0, t1: speeds[device].peak(t0, t1)
+                                  if device in speeds else 0.0, margin_s)
+        for k in range(len(self.calls)):
+            n = plan.input_of[k]
+            self._compare(k, answers.get(k), allowed[n], errors[n])
+        if errors:
+            self.say(f"timing on the job's clock: {len(errors)} inputs ({len(self.commands)} "
+                     f"command messages), errors: median "
+                     f"{statistics.median(map(abs, errors)) * 1e3:.1f} ms, largest "
+                     f"{max(errors, key=abs) * 1e3:+.1f} ms; margin {margin_s * 1e3:.1f} ms")
+
+    def _compare(self, k: int, answer: Any, allowance: float, error_s: float) -> None:
+        call = self.calls[k]
+        what = f"#{k + 1} {call.service} [{error_s * 1e3:+.1f} ms]"
         if answer is None:
             self._differ(f"{what}: no answer in {self.timeout:g} s")
         elif call.response is None:
             self.say(f"{what}: answered (the recording has no answer to compare)")
         else:
-            found = differences(plain(call.response), plain(answer), abs_tol=self.tolerance)
+            recorded, replayed = plain(call.response), plain(answer)
+            found = differences(recorded, replayed, abs_tol=self.tolerance + allowance)
             for line in found:
-                self._differ(f"{what} {line}")
-            if not found:
+                self._differ(f"{what} {line} (allowed: {self.tolerance:g} + {allowance:.3g} "
+                             "for the timing)")
+            deviation = largest_deviation(recorded, replayed)
+            if not found and deviation > self.tolerance:
+                self.say(f"{what}: equal, numbers {deviation:.3g} apart, within "
+                         f"{self.tolerance:g} + {allowance:.3g} (how far the replay's timing "
+                         "errors may have moved the device)")
+            elif not found:
                 self.say(f"{what}: equal")
 
     def _differ(self, line: str) -> None:
         self.differences.append(line)
         self.say(line)
+
+
+def _ns(stamp: Any) -> int:
+    return stamp.sec * 1_000_000_000 + stamp.nanosec
+
+
+def _wait(executor: SingleThreadedExecutor, done: Callable[[], bool], timeout_s: float) -> bool:
+    deadline = time.monotonic() + timeout_s
+    while not done() and time.monotonic() < deadline:
+        executor.spin_once(timeout_sec=0.05)
+    return done()
+
+
+def node_path(namespace: str, name: str) -> str:
+    return f"{namespace.rstrip('/')}/{name}"
+
+
+def device_of_service(service: str) -> str:
+    """The node a service belongs to (an action's too): the device its calls drive or read."""
+    return service.split("/_action/", 1)[0].rsplit("/", 1)[0]
+
+
+def recorded_clock(contents: Contents) -> ClockMap:
+    """The recorded job's simulated time by its wall clock, from its /clock messages."""
+    clock = ClockMap()
+    for m in contents.messages:
+        if m.channel.type == CLOCK_TYPE:
+            clock.add(m.publish_ns, _ns(deserialize_message(m.data, Clock).clock))
+    return clock
+
+
+def _base_speed(odometry: Any) -> float:
+    twist = odometry.twist.twist
+    return max(math.hypot(twist.linear.x, twist.linear.y) * 1000.0,      # mm/s
+               math.degrees(abs(twist.angular.z)))                      # degree/s
+
+
+def _arm_speed(joints: Any) -> float:
+    """degree/s of the arm's joints, mm/s of the gripper's opening (both fingers); the base's
+    wheels are not the arm's."""
+    return max((abs(v) * (2000.0 if name.startswith("gripper") else math.degrees(1.0))
+                for name, v in zip(joints.name, joints.velocity) if "wheel" not in name),
+               default=0.0)
+
+
+# a node's device: the topic (beside the node, in its namespace) that says how fast it moves,
+# in the units of its answers per second
+DEVICE_SPEEDS = {"vehicle_node": ("odom", "nav_msgs/msg/Odometry", _base_speed),
+                 "acti_middle_node": ("joint_states", "sensor_msgs/msg/JointState", _arm_speed)}
+
+
+def recorded_speeds(contents: Contents, clock: ClockMap) -> dict[str, SpeedTrack]:
+    """Each device's recorded speed by the job's simulated time (devices: node paths)."""
+    tracks: dict[str, SpeedTrack] = {}
+    for m in contents.messages:
+        namespace, name = m.channel.topic.rsplit("/", 1)
+        for node, (topic, type_name, speed) in DEVICE_SPEEDS.items():
+            if name == topic and m.channel.type == type_name:
+                message = deserialize_message(m.data, type_class(type_name))
+                tracks.setdefault(node_path(namespace, node), SpeedTrack()).add(
+                    clock.sim_at(m.publish_ns), speed(message))
+    return tracks

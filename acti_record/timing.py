@@ -1,0 +1,161 @@
+"""The timing of a replay, and what it allows a measured answer.
+
+A replay cannot send a request at the very moment of the job's simulated time it came in the
+recording: a read taken while a device moves, or a stop given to a moving base, lands a few
+milliseconds earlier or later, and the device is that much further on. Every input of a replay
+(a call, a republished command message) is timed on the job's own clock, its simulated time
+(`ClockMap`), at its recorded offset from the event it followed (a request taken, an answer sent,
+a message published); what it missed by is measured on the same clock in both runs
+(`Plan.errors_s`). While the recording shows its device moving, that error moves the device
+by up to its speed times the error, and the difference stays in every later read of the device
+(a stop given late leaves the base further on for good): `Plan.allowances`."""
+from __future__ import annotations
+
+import bisect
+import statistics
+from dataclasses import dataclass, field
+from typing import Callable
+
+from acti_record.calls import Call
+from acti_record.reading import Message
+
+
+@dataclass
+class ClockMap:
+    """A job's simulated time at moments of its wall clock, from the /clock messages it
+    published (source timestamp: wall ns; contents: simulated ns), added in order. Between two
+    messages the time is interpolated; past the last it runs on at the job's own rate."""
+    walls: list[int] = field(default_factory=list)
+    sims: list[int] = field(default_factory=list)
+
+    def add(self, wall_ns: int, sim_ns: int) -> None:
+        if not self.walls or wall_ns > self.walls[-1] and sim_ns >= self.sims[-1]:
+            self.walls.append(wall_ns)
+            self.sims.append(sim_ns)
+
+    def rate(self) -> float:
+        """Simulated seconds per wall second over the map (1 without two messages)."""
+        span = self.walls[-1] - self.walls[0] if self.walls else 0
+        return (self.sims[-1] - self.sims[0]) / span if span > 0 else 1.0
+
+    def sim_at(self, wall_ns: int) -> float:
+        """The simulated time [ns] at wall_ns (wall_ns itself with no /clock at all)."""
+        if not self.walls:
+            return float(wall_ns)
+        i = bisect.bisect_right(self.walls, wall_ns)
+        if i == 0 or i == len(self.walls):
+            edge = 0 if i == 0 else -1
+            return self.sims[edge] + (wall_ns - self.walls[edge]) * self.rate()
+        w0, w1, s0, s1 = self.walls[i - 1], self.walls[i], self.sims[i - 1], self.sims[i]
+        return s0 + (s1 - s0) * (wall_ns - w0) / (w1 - w0)
+
+    def period_ns(self) -> float:
+        """The simulated time between two messages (the median): the map's resolution."""
+        steps = [b - a for a, b in zip(self.sims, self.sims[1:]) if b > a]
+        return statistics.median(steps) if steps else 0.0
+
+
+@dataclass
+class SpeedTrack:
+    """A device's recorded speed over simulated time, in the units of its answers per second
+    (mm/s, degree/s: the larger)."""
+    times: list[int] = field(default_factory=list)
+    speeds: list[float] = field(default_factory=list)
+
+    def add(self, sim_ns: float, speed: float) -> None:
+        i = bisect.bisect_right(self.times, sim_ns)
+        self.times.insert(i, sim_ns)
+        self.speeds.insert(i, abs(speed))
+
+    def peak(self, t0: float, t1: float) -> float:
+        """The highest speed from t0 to t1, the samples on either side included."""
+        i0 = max(bisect.bisect_left(self.times, t0) - 1, 0)
+        i1 = bisect.bisect_right(self.times, t1) + 1
+        return max(self.speeds[i0:i1], default=0.0)
+
+
+NEVER = float("-inf")
+
+
+class Plan:
+    """What a replay sends, in the recorded order: the calls (`acti_record.calls`) and the
+    messages of command topics, each an input of its device; the events they make (a request
+    taken, an answer sent, a message published), on the recording's clock; for each input, the
+    answers it waits for (those given before it in the recording) and its anchor, the event
+    right before it, from which its recorded offset is kept."""
+
+    def __init__(self, calls: list[Call], commands: list[Message], device_of_call: Callable[[Call], str],
+                 device_of_topic: dict[str, str], clock: ClockMap) -> None:
+        self.recorded_ns: list[int] = []                       # each event's, wall
+        self.request_event = [self._event(c.request_ns) for c in calls]
+        self.answer_event = [None if c.response_ns is None else self._event(c.response_ns)
+                             for c in calls]
+        items = [(c.request_ns, "call", k, self.request_event[k], device_of_call(c))
+                 for k, c in enumerate(calls)]
+        items += [(m.publish_ns, "message", k, self._event(m.publish_ns),
+                   device_of_topic[m.channel.topic]) for k, m in enumerate(commands)]
+        items.sort(key=lambda item: (item[0], item[3]))
+        self.inputs = [(kind, k) for _, kind, k, _, _ in items]
+        self.nth_of_service = [sum(1 for earlier in calls[:k] if earlier.service == c.service)
+                               for k, c in enumerate(calls)]
+        self.input_of = {k: n for n, (kind, k) in enumerate(self.inputs) if kind == "call"}
+        self.event_of = [event for *_, event, _ in items]
+        self.devices = [device for *_, device in items]
+        self.sim_ns = [clock.sim_at(t) for t in self.recorded_ns]
+        order = sorted(range(len(self.recorded_ns)), key=lambda e: (self.recorded_ns[e], e))
+        rank = {e: r for r, e in enumerate(order)}
+        self.anchors = [order[rank[e] - 1] if rank[e] else None for e in self.event_of]
+        self.waits = [{k for k, a in enumerate(self.answer_event)
+                       if a is not None and self.recorded_ns[a] <= self.recorded_ns[e]}
+                      for e in self.event_of]
+
+    def _event(self, recorded_ns: int) -> int:
+        self.recorded_ns.append(recorded_ns)
+        return len(self.recorded_ns) - 1
+
+    def due_ns(self, n: int, job_wall_ns: dict[int, int], job_clock: ClockMap,
+               rate: float) -> float:
+        """When input n is due on the job's simulated clock: its anchor's time there plus its
+        recorded offset from it (NEVER: at once, when it has no anchor)."""
+        anchor = self.anchors[n]
+        if anchor is None or anchor not in job_wall_ns:
+            return NEVER
+        return job_clock.sim_at(job_wall_ns[anchor]) + \
+            (self.sim_ns[self.event_of[n]] - self.sim_ns[anchor]) / rate
+
+    def errors_s(self, job_wall_ns: dict[int, int], job_clock: ClockMap,
+                 rate: float) -> list[float]:
+        """Each input's timing error [s] on the job's simulated clock: how much later (< 0:
+        earlier) than its recorded offset from its anchor the job had it in the replay."""
+        errors = []
+        for n, event in enumerate(self.event_of):
+            anchor = self.anchors[n]
+            if anchor is None or anchor not in job_wall_ns or event not in job_wall_ns:
+                errors.append(0.0)
+                continue
+            replayed = job_clock.sim_at(job_wall_ns[event]) - job_clock.sim_at(job_wall_ns[anchor])
+            errors.append((replayed - (self.sim_ns[event] - self.sim_ns[anchor]) / rate) / 1e9)
+        return errors
+
+    def allowances(self, errors_s: list[float], peak_speed: Callable[[str, float, float], float],
+                   margin_s: float) -> list[float]:
+        """For each input, how far its device may be from where the recording had it once the
+        input is made: the sum, over the device's inputs up to this one, of (|error| +
+        margin_s) times the device's highest recorded speed from the input before to the
+        input after (while that input's timing can matter); a timing error moves a device
+        for good (a stop given late leaves the base further on)."""
+        times = [self.sim_ns[e] for e in self.event_of]
+        own: dict[str, list[int]] = {}
+        for n, device in enumerate(self.devices):
+            own.setdefault(device, []).append(n)
+        drift: dict[str, float] = {}
+        out = []
+        for n, device in enumerate(self.devices):
+            mine = own[device]
+            k = mine.index(n)
+            t0 = times[mine[k - 1]] if k else times[n]
+            t1 = times[mine[k + 1]] if k + 1 < len(mine) else times[n]
+            drift[device] = drift.get(device, 0.0) + \
+                peak_speed(device, t0, t1) * (abs(errors_s[n]) + margin_s)
+            out.append(drift[device])
+        return out
