@@ -12,6 +12,7 @@ by up to its speed times the error, and the difference stays in every later read
 from __future__ import annotations
 
 import bisect
+import math
 import statistics
 from dataclasses import dataclass, field
 from typing import Callable
@@ -67,6 +68,25 @@ class SpeedTrack:
         self.times.insert(i, sim_ns)
         self.speeds.insert(i, abs(speed))
 
+    def departure(self, t0: float, t1: float, by: float) -> float | None:
+        """When the speed, after t0 and before t1, first leaves its value at t0 (by more than
+        `by`): where that change, extended back along its first two samples, began (a ramp's
+        start, whatever the samples' phase); None when it does not."""
+        i = max(bisect.bisect_right(self.times, t0) - 1, 0)
+        if not self.times:
+            return None
+        v0 = self.speeds[i]
+        for j in range(i + 1, len(self.times)):
+            t, v = self.times[j], self.speeds[j]
+            if t >= t1:
+                return None
+            if abs(v - v0) > by:
+                if j + 1 < len(self.times) and (self.speeds[j + 1] - v) * (v - v0) > 0:
+                    slope = (self.speeds[j + 1] - v) / (self.times[j + 1] - t)
+                    return max(t - (v - v0) / slope, t0)
+                return t
+        return None
+
     def peak(self, t0: float, t1: float) -> float:
         """The highest speed from t0 to t1, the samples on either side included."""
         i0 = max(bisect.bisect_left(self.times, t0) - 1, 0)
@@ -90,6 +110,8 @@ class Plan:
         self.request_event = [self._event(c.request_ns) for c in calls]
         self.answer_event = [None if c.response_ns is None else self._event(c.response_ns)
                              for c in calls]
+        self.call_of_request = {e: k for k, e in enumerate(self.request_event)}
+        self.call_of_answer = {e: k for k, e in enumerate(self.answer_event) if e is not None}
         items = [(c.request_ns, "call", k, self.request_event[k], device_of_call(c))
                  for k, c in enumerate(calls)]
         items += [(m.publish_ns, "message", k, self._event(m.publish_ns),
@@ -137,25 +159,56 @@ class Plan:
             errors.append((replayed - (self.sim_ns[event] - self.sim_ns[anchor]) / rate) / 1e9)
         return errors
 
-    def allowances(self, errors_s: list[float], peak_speed: Callable[[str, float, float], float],
-                   margin_s: float) -> list[float]:
-        """For each input, how far its device may be from where the recording had it once the
-        input is made: the sum, over the device's inputs up to this one, of (|error| +
-        margin_s) times the device's highest recorded speed from the input before to the
-        input after (while that input's timing can matter); a timing error moves a device
-        for good (a stop given late leaves the base further on)."""
-        times = [self.sim_ns[e] for e in self.event_of]
-        own: dict[str, list[int]] = {}
-        for n, device in enumerate(self.devices):
-            own.setdefault(device, []).append(n)
-        drift: dict[str, float] = {}
+    def reaction_errors(self, device: str, recorded: SpeedTrack, replayed: SpeedTrack,
+                        job_wall_ns: dict[int, int], job_clock: ClockMap,
+                        by: float) -> list[tuple[float, float]]:
+        """The device's own timing: after each of its inputs (before the next), when its
+        speed began to change (`SpeedTrack.departure`: a start, a stop's braking, a jog's end),
+        measured from when the job took the input, in both runs. For each input it changed
+        after in both: the change's recorded time and how much later it came in the replay
+        [s] (the job reacting later: a stop planned longer under load)."""
+        mine = [n for n, d in enumerate(self.devices) if d == device]
         out = []
-        for n, device in enumerate(self.devices):
+        for k, n in enumerate(mine):
+            event = self.event_of[n]
+            later = self.event_of[mine[k + 1]] if k + 1 < len(mine) else None
+            if event not in job_wall_ns:
+                continue
+            t_rec, t_rep = self.sim_ns[event], job_clock.sim_at(job_wall_ns[event])
+            end_rec = self.sim_ns[later] if later is not None else math.inf
+            end_rep = job_clock.sim_at(job_wall_ns[later]) if later in job_wall_ns else math.inf
+            rec = recorded.departure(t_rec, end_rec, by)
+            rep = replayed.departure(t_rep, end_rep, by)
+            if rec is not None and rep is not None:
+                out.append((rec, ((rep - t_rep) - (rec - t_rec)) / 1e9))
+        return out
+
+    def allowances(self, errors_s: list[float], peak_speed: Callable[[str, float, float], float],
+                   margin_s: float, reactions: dict[str, list[tuple[float, float]]] | None = None
+                   ) -> list[float]:
+        """For each input, how far its device may be from where the recording had it once the
+        input is made: the sum, over the device's timed events up to this one (its inputs and
+        its reactions, `reaction_errors`), of (|error| + margin_s) times the
+        device's highest recorded speed from the event before to the event after (while that
+        event's timing can matter); a timing error moves a device for good (a stop given late
+        leaves the base further on)."""
+        events = [(self.sim_ns[e], n, self.devices[n], errors_s[n])
+                  for n, e in enumerate(self.event_of)]
+        events += [(t, None, device, error) for device, found in (reactions or {}).items()
+                   for t, error in found]
+        events.sort(key=lambda item: item[0])
+        own: dict[str, list[int]] = {}
+        for i, (_, _, device, _) in enumerate(events):
+            own.setdefault(device, []).append(i)
+        drift: dict[str, float] = {}
+        out = [0.0] * len(self.event_of)
+        for i, (t, n, device, error) in enumerate(events):
             mine = own[device]
-            k = mine.index(n)
-            t0 = times[mine[k - 1]] if k else times[n]
-            t1 = times[mine[k + 1]] if k + 1 < len(mine) else times[n]
+            k = mine.index(i)
+            t0 = events[mine[k - 1]][0] if k else t
+            t1 = events[mine[k + 1]][0] if k + 1 < len(mine) else t
             drift[device] = drift.get(device, 0.0) + \
-                peak_speed(device, t0, t1) * (abs(errors_s[n]) + margin_s)
-            out.append(drift[device])
+                peak_speed(device, t0, t1) * (abs(error) + margin_s)
+            if n is not None:
+                out[n] = drift[device]
         return out

@@ -102,3 +102,44 @@ def test_a_late_stop_carries_its_drift_into_every_later_read_of_its_device():
     assert allowed[4] == 0.0
     assert allowed[5] == pytest.approx(allowed[3] + 200 * 0.004)          # the jog starts
     assert allowed[6] == pytest.approx(allowed[5] + 200 * 0.007)
+
+
+def ramp(track: SpeedTrack, start_ms: float, top: float, accel: float, until_ms: float,
+         brake_ms: float | None = None, phase_ms: float = 0.0) -> None:
+    """Samples every 20 ms (from phase_ms) of a speed that rises at `accel` per s from
+    start_ms to `top`, and falls again from brake_ms."""
+    t = phase_ms
+    while t < until_ms:
+        v = min(top, max(0.0, (t - start_ms) / 1000 * accel))
+        if brake_ms is not None and t > brake_ms:
+            v = max(0.0, v - (t - brake_ms) / 1000 * accel)
+        track.add(t * MS, v)
+        t += 20
+
+
+def test_a_departure_is_where_the_speed_began_to_change_whatever_the_samples_phase():
+    for phase in (0.0, 7.0, 13.0):
+        track = SpeedTrack()
+        ramp(track, 105.0, 300.0, 500.0, 3000.0, brake_ms=2007.0, phase_ms=phase)
+        assert track.departure(50 * MS, 1000 * MS, 1.0) == pytest.approx(105 * MS, abs=0.01 * MS)
+        assert track.departure(1000 * MS, 3000 * MS, 1.0) == pytest.approx(2007 * MS, abs=0.01 * MS)
+        assert track.departure(1000 * MS, 1900 * MS, 1.0) is None      # steady until then
+
+
+def test_the_jobs_own_reaction_time_is_timed_in_both_runs():
+    plan = tour()                                   # the stop is taken at 1000 ms
+    recorded, replayed = SpeedTrack(), SpeedTrack()
+    ramp(recorded, 3.0, 500.0, 2000.0, 2000.0, brake_ms=1003.0)   # starts, brakes 10 ms after
+    ramp(replayed, 53.0, 500.0, 2000.0, 2000.0, brake_ms=1123.0)  # 60 ms; 130 ms after
+    job = ClockMap()
+    job.add(0, 0)
+    job.add(10_000 * MS, 10_000 * MS)
+    # all on time: the job's simulated time as the recording's (7 ms behind its wall clock)
+    walls = {e: t - 7 * MS for e, t in enumerate(plan.recorded_ns)}
+    found = plan.reaction_errors("/base", recorded, replayed, walls, job, 1.0)
+    assert [round(t / MS) for t, _ in found] == [3, 1003]
+    assert [e for _, e in found] == [pytest.approx(0.050, abs=1e-5), pytest.approx(0.120, abs=1e-5)]
+    speeds = {"/base": recorded}
+    allowed = plan.allowances([0.0] * 7, lambda d, t0, t1: speeds[d].peak(t0, t1) if d in speeds
+                              else 0.0, 0.0, {"/base": found})
+    assert allowed[3] == pytest.approx(500 * 0.050 + 500 * 0.120)    # the read after the stop

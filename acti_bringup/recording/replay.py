@@ -29,8 +29,10 @@ SERVICE_WAIT_S = 30.0
 REPUBLISH_DEPTH = 1000
 ACKED_WAIT_S = 5.0
 MATCH_WAIT_S = 10.0       # for the job's clock, its service events, the command topics' listeners
-EVENT_WAIT_S = 5.0        # for the job's events of the last calls, after their answers
+EVENT_WAIT_S = 5.0
+SPIN_S = 0.005            # the longest wait for the job's news while an input is not due        # for the job's events of the last calls, after their answers
 CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
+MOVING = 1.0              # a device's speed changes by more than this (mm/s, degree/s): it reacts
 
 
 def plain(value: Any) -> Any:
@@ -136,6 +138,7 @@ class RequestReplay:
         self.commands: list[Message] = []
         self.clock = recorded_clock(contents)     # the recorded job's simulated time
         self.job_clock = ClockMap()
+        self.job_speeds: dict[str, tuple[str, list[bytes]]] = {}   # the devices' speed topics
         self.taken: dict[str, list[tuple[int, tuple]]] = {}   # the job's requests taken
         self.answered: dict[tuple, int] = {}                   # (service, client, seq): stamp
 
@@ -153,21 +156,26 @@ class RequestReplay:
         latency: list[int] = []                         # a request sent until the job took it
         following = 0
         while (following < len(plan.inputs) or pending) and not self.stopped():
-            while following < len(plan.inputs) and plan.waits[following] <= set(answers):
+            wait_s = SPIN_S
+            if following < len(plan.inputs) and plan.waits[following] <= set(answers):
                 kind, k = plan.inputs[following]
                 early = statistics.median(latency) if kind == "call" and latency else 0
-                due = plan.due_ns(following, self._job_times(plan, sent), self.job_clock,
-                                  self.rate)
-                if self.job_clock.sim_at(time.time_ns()) < due - early:
-                    break
-                sent[plan.event_of[following]] = time.time_ns()
-                if kind == "call":
-                    pending[k] = self.clients[self.calls[k].service].call_async(
-                        self.calls[k].request)
-                else:
-                    publishers[self.commands[k].channel.topic].publish(self.commands[k].data)
-                following += 1
-            self.executor.spin_once(timeout_sec=0.001)
+                anchor = plan.anchors[following]
+                known = {} if anchor is None else {anchor: self._job_time(plan, anchor, sent)}
+                due = plan.due_ns(following, known, self.job_clock, self.rate) - early
+                left_s = (due - self.job_clock.sim_at(time.time_ns())) / 1e9
+                if left_s <= 0:
+                    sent[plan.event_of[following]] = time.time_ns()
+                    if kind == "call":
+                        pending[k] = self.clients[self.calls[k].service].call_async(
+                            self.calls[k].request)
+                    else:
+                        publishers[self.commands[k].channel.topic].publish(
+                            self.commands[k].data)
+                    following += 1
+                    continue
+                wait_s = min(wait_s, left_s)
+            self.executor.spin_once(timeout_sec=wait_s)
             for k, future in list(pending.items()):
                 asked = sent[plan.request_event[k]]
                 if future.done() or time.time_ns() - asked > self.timeout * 1e9:
@@ -223,6 +231,12 @@ class RequestReplay:
         clocks = [c.topic for c in self.contents.channels if c.type == CLOCK_TYPE]
         if clocks:
             watched.append(self.node.create_subscription(Clock, clocks[0], self._on_clock, 100))
+        for channel in self.contents.channels:
+            device = device_of_speed_topic(channel.topic, channel.type)
+            if device is not None:      # kept as received, read at the end (cheap meanwhile)
+                kept = self.job_speeds.setdefault(device, (channel.type, []))[1]
+                watched.append(self.node.create_subscription(
+                    type_class(channel.type), channel.topic, kept.append, 100, raw=True))
         for service, service_type in {(c.service, c.service_type) for c in self.calls}:
             watched.append(self.node.create_subscription(
                 type_class(service_type + EVENT_TYPE_SUFFIX), service + EVENT_TOPIC_SUFFIX,
@@ -247,25 +261,37 @@ class RequestReplay:
         nth = plan.nth_of_service[k]
         return taken[nth] if nth < len(taken) else None
 
+    def _job_time(self, plan: Plan, event: int, sent: dict[int, int]) -> int:
+        """When an event made so far happened, on the job's wall clock: a request when the job
+        took it and an answer when it sent it (by the job's events, else when this replay sent
+        or got it), a message when it was published."""
+        if event in plan.call_of_request:
+            taken = self._taken(plan, plan.call_of_request[event])
+            return sent[event] if taken is None else taken[0]
+        if event in plan.call_of_answer:
+            taken = self._taken(plan, plan.call_of_answer[event])
+            return self.answered.get(taken[1], sent[event]) if taken else sent[event]
+        return sent[event]
+
     def _job_times(self, plan: Plan, sent: dict[int, int]) -> dict[int, int]:
-        """Each event made so far on the job's wall clock: a request when the job took it and
-        an answer when it sent it (by the job's events), a message when it was published."""
-        times = dict(sent)
-        for k in range(len(self.calls)):
-            taken = self._taken(plan, k)
-            if taken is not None:
-                times[plan.request_event[k]] = taken[0]
-                answer = plan.answer_event[k]
-                if answer in times and taken[1] in self.answered:
-                    times[answer] = self.answered[taken[1]]
-        return times
+        return {event: self._job_time(plan, event, sent) for event in sent}
+
+    def _job_speed(self, device: str) -> SpeedTrack:
+        track = SpeedTrack()
+        type_name, kept = self.job_speeds.get(device, ("", []))
+        for data in kept:
+            track.add(*device_speed(type_name, deserialize_message(data, type_class(type_name))))
+        return track
 
     def _compare_all(self, plan: Plan, answers: dict[int, Any], job_ns: dict[int, int]) -> None:
         errors = plan.errors_s(job_ns, self.job_clock, self.rate)
-        speeds = recorded_speeds(self.contents, self.clock)
+        speeds = recorded_speeds(self.contents)
+        reactions = {device: plan.reaction_errors(device, track, self._job_speed(device),
+                                                  job_ns, self.job_clock, MOVING)
+                     for device, track in speeds.items()}
         margin_s = self.clock.period_ns() / 1e9
         allowed = plan.allowances(errors, lambda device, t0, t1: speeds[device].peak(t0, t1)
-                                  if device in speeds else 0.0, margin_s)
+                                  if device in speeds else 0.0, margin_s, reactions)
         for k in range(len(self.calls)):
             n = plan.input_of[k]
             self._compare(k, answers.get(k), allowed[n], errors[n])
@@ -274,6 +300,12 @@ class RequestReplay:
                      f"command messages), errors: median "
                      f"{statistics.median(map(abs, errors)) * 1e3:.1f} ms, largest "
                      f"{max(errors, key=abs) * 1e3:+.1f} ms; margin {margin_s * 1e3:.1f} ms")
+        for device, found in reactions.items():
+            if found:
+                worst = max((e for _, e in found), key=abs)
+                self.say(f"{device} reacted to {len(found)} inputs, errors: median "
+                         f"{statistics.median(abs(e) for _, e in found) * 1e3:.1f} ms, largest "
+                         f"{worst * 1e3:+.1f} ms")
 
     def _compare(self, k: int, answer: Any, allowance: float, error_s: float) -> None:
         call = self.calls[k]
@@ -345,19 +377,32 @@ def _arm_speed(joints: Any) -> float:
 
 
 # a node's device: the topic (beside the node, in its namespace) that says how fast it moves,
-# in the units of its answers per second
+# in the units of its answers per second, stamped with the simulated time
 DEVICE_SPEEDS = {"vehicle_node": ("odom", "nav_msgs/msg/Odometry", _base_speed),
                  "acti_middle_node": ("joint_states", "sensor_msgs/msg/JointState", _arm_speed)}
 
 
-def recorded_speeds(contents: Contents, clock: ClockMap) -> dict[str, SpeedTrack]:
-    """Each device's recorded speed by the job's simulated time (devices: node paths)."""
+def recorded_speeds(contents: Contents) -> dict[str, SpeedTrack]:
+    """Each device's recorded speed by the job's simulated time (the messages' stamps)."""
     tracks: dict[str, SpeedTrack] = {}
     for m in contents.messages:
-        namespace, name = m.channel.topic.rsplit("/", 1)
-        for node, (topic, type_name, speed) in DEVICE_SPEEDS.items():
-            if name == topic and m.channel.type == type_name:
-                message = deserialize_message(m.data, type_class(type_name))
-                tracks.setdefault(node_path(namespace, node), SpeedTrack()).add(
-                    clock.sim_at(m.publish_ns), speed(message))
+        device = device_of_speed_topic(m.channel.topic, m.channel.type)
+        if device is not None:
+            tracks.setdefault(device, SpeedTrack()).add(
+                *device_speed(m.channel.type, deserialize_message(m.data, type_class(m.channel.type))))
     return tracks
+
+
+def device_of_speed_topic(topic: str, type_name: str) -> str | None:
+    """The device (node path) whose speed a topic tells, None for another topic."""
+    namespace, name = topic.rsplit("/", 1)
+    for node, (speed_topic, speed_type, _) in DEVICE_SPEEDS.items():
+        if name == speed_topic and type_name == speed_type:
+            return node_path(namespace, node)
+    return None
+
+
+def device_speed(type_name: str, message: Any) -> tuple[int, float]:
+    """(simulated time of the message's stamp [ns], the device's speed then)."""
+    speed = next(fn for _, t, fn in DEVICE_SPEEDS.values() if t == type_name)
+    return _ns(message.header.stamp), speed(message)
