@@ -5,10 +5,12 @@
         republishes the recorded topics (not the hidden ones: service events, the actions'
         own topics) with their recorded timing, R times as fast
     python -m acti_bringup.replay FILE.mcap --requests [--rate R]
-        sends the recorded service requests and action goals to the running job in their
-        recorded order and timing and compares each answer with the recorded one (motion ids,
-        stamps and durations not compared, measured numbers within --tolerance); prints the
-        differences, exit status 1 on any
+        sends the recorded service requests and action goals, and the messages of the topics
+        the job listens to (cmd_vel …), to the running job in their recorded order and timing
+        (on its simulated clock) and compares each answer with the recorded one (motion ids,
+        stamps and durations not compared; states, flags, ids exactly; measured numbers within
+        --tolerance plus how far the measured timing errors may have moved the device);
+        prints every call's outcome, exit status 1 on any difference
 
 A file that is not a recording: one line saying why, exit status 2.
 """
@@ -44,7 +46,8 @@ def parse(args: list[str]) -> argparse.Namespace:
                         help=f"longest wait for one answer (default {ANSWER_TIMEOUT_S:g} s)")
     parser.add_argument("--tolerance", type=float, default=ABS_TOL, metavar="T",
                         help="largest difference of two equal measured numbers, in the "
-                             f"services' units (default {ABS_TOL:g}: mm, degree …)")
+                             f"services' units (default {ABS_TOL:g}: mm, degree …), beside "
+                             "what the replay's timing errors may have moved the device")
     options = parser.parse_args(args)
     if not options.rate > 0:
         parser.error("--rate must be positive")

@@ -1,6 +1,6 @@
 """Replaying a recording over ROS: its topics republished with their timing, or its service
-calls and action goals sent again to a running job and each answer compared with the recorded
-one (`acti_record.calls`)."""
+calls, action goals and command messages sent again to a running job on its own clock
+(`acti_record.timing`) and each answer compared with the recorded one (`acti_record.calls`)."""
 from __future__ import annotations
 
 import array
