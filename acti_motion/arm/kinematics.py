@@ -101,10 +101,6 @@ def rotate_about(axis: np.ndarray, angle: float) -> np.ndarray:
     return pin.exp3(np.asarray(axis, float) * angle)
 
 
-def _unit(v: np.ndarray) -> np.ndarray:
-    return v / np.linalg.norm(v)
-
-
 def wrap(a: float) -> float:
     """An angle in (-π, π]."""
     return math.pi - (math.pi - a) % TWO_PI
@@ -206,7 +202,12 @@ class ArmKinematics:
         """(e1, e2): the arm angle's zero direction and its +90° direction, normal to u = S→W.
         e1 = ŷ × u where u is clear of ±ŷ, else ẑ × u; in plain floats (one 3-vector: numpy's
         calls cost more than the arithmetic, twice in every CP plan)."""
-        x, y, z = map(float, u)
+        e1, e2 = self._reference_floats(*map(float, u))
+        return np.array(e1), np.array(e2)
+
+    @staticmethod
+    def _reference_floats(x: float, y: float, z: float) -> tuple[tuple[float, ...], ...]:
+        """`reference` of u = (x, y, z), as plain floats."""
         e = (z, 0.0, -x)                        # ŷ × u
         n = math.hypot(z, x)
         if n <= LATERAL_CONE:
@@ -214,11 +215,10 @@ class ArmKinematics:
             if n <= 0.0:
                 raise AssertionError("unreachable: y and z cannot both be parallel to u")
         a, b, c = e[0] / n, e[1] / n, e[2] / n
-        return (np.array([a, b, c]),
-                np.array([y * c - z * b, z * a - x * c, x * b - y * a]))      # u × e1
+        return (a, b, c), (y * c - z * b, z * a - x * c, x * b - y * a)      # e1, u × e1
 
     @staticmethod
-    def reference_strength(u: np.ndarray) -> float:
+    def reference_strength(u: np.ndarray | tuple[float, float, float]) -> float:
         """|ŷ × u|: 1 far from the arm angle's undefined direction (u = ±ŷ), 0 on it."""
         return float(math.hypot(u[0], u[2]))
 
@@ -230,19 +230,29 @@ class ArmKinematics:
         last = getattr(self._local, "elbow", None)
         if last is not None and last[0] == key:
             return last[1]
-        pts = self.points(q)
-        u = _unit(pts.wrist - pts.shoulder)
-        v = pts.elbow - pts.shoulder
-        n = v - np.dot(v, u) * u
-        norm = np.linalg.norm(n)
-        n = self.reference(u)[0] if norm < 1e-9 else n / norm   # stretched: any angle; report 0
+        d = self.data                         # in plain floats: a few 3-vectors
+        pin.forwardKinematics(self.model, d, q)
+        (sx, sy, sz), (ex, ey, ez), (wx, wy, wz) = (d.oMi[i].translation.tolist()
+                                                     for i in (2, 4, 6))
+        ux, uy, uz = wx - sx, wy - sy, wz - sz
+        r = math.sqrt(ux * ux + uy * uy + uz * uz)
+        ux, uy, uz = ux / r, uy / r, uz / r
+        vx, vy, vz = ex - sx, ey - sy, ez - sz
+        along = vx * ux + vy * uy + vz * uz
+        nx, ny, nz = vx - along * ux, vy - along * uy, vz - along * uz
+        norm = math.sqrt(nx * nx + ny * ny + nz * nz)
+        u = np.array([ux, uy, uz])
+        n = (np.array(self._reference_floats(ux, uy, uz)[0]) if norm < 1e-9   # stretched: any
+             else np.array([nx / norm, ny / norm, nz / norm]))                # angle; report 0
         u.flags.writeable = n.flags.writeable = False
         self._local.elbow = (key, (u, n))
         return u, n
 
     def angle_of(self, u: np.ndarray, n: np.ndarray) -> float:
-        e1, e2 = self.reference(u)
-        return math.atan2(float(np.dot(n, e2)), float(np.dot(n, e1)))
+        e1, e2 = self._reference_floats(*map(float, u))
+        n0, n1, n2 = map(float, n)
+        return math.atan2(n0 * e2[0] + n1 * e2[1] + n2 * e2[2],
+                          n0 * e1[0] + n1 * e1[1] + n2 * e1[2])
 
     def arm_angle(self, q: np.ndarray) -> float:
         """The arm angle ψ (rad) of the posture q."""
@@ -267,6 +277,14 @@ class ArmKinematics:
         """The branch of q as CarPosWithElbow.struct_flag bits."""
         return ((FLAG_SHOULDER if q[1] < 0 else 0) | (FLAG_ELBOW if q[3] > 0 else 0)
                 | (FLAG_WRIST if q[5] < 0 else 0))
+
+    def wrist_direction(self, flange: np.ndarray) -> tuple[float, float, float]:
+        """The unit direction S→W of a flange pose (4×4), in plain floats."""
+        (_, _, ax, px), (_, _, ay, py), (_, _, az, pz) = flange[:3].tolist()
+        sx, sy, sz = self.shoulder.tolist()
+        x, y, z = px - self.hand * ax - sx, py - self.hand * ay - sy, pz - self.hand * az - sz
+        r = max(math.sqrt(x * x + y * y + z * z), 1e-12)
+        return x / r, y / r, z / r
 
     def wrist_of(self, flange: np.ndarray) -> np.ndarray:
         """The wrist point of a flange pose (4×4), or of each of many (N×4×4)."""

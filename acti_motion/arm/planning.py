@@ -137,6 +137,10 @@ class MovePlanning:
         to_robot = frames.base_inverse
         shoulder = to_robot[:3, :3] @ kin.shoulder + to_robot[:3, 3]
         radius = self.planner.reach_radius(frames)
+        if len(positions) <= FEW_POSTURES:            # a target, a line's ends: plain floats
+            centre = shoulder.tolist()
+            if all(math.dist(p, centre) <= radius for p in positions.tolist()):
+                return
         dist = np.linalg.norm(positions - shoulder, axis=1)
         far = np.flatnonzero(~(dist <= radius + 1e-9))
         if len(far):
@@ -157,6 +161,8 @@ class MovePlanning:
 
     def _check_cartesian_positions(self, positions_mm: np.ndarray, label: str) -> None:
         lim = self.soft_limit_cartesian
+        if _well_inside(positions_mm, lim, 0.0):      # a target, a line's ends: at once
+            return
         hit = _first_exit(positions_mm, lim[:, 0], lim[:, 1], 1e-9)
         if hit is not None:
             k, axis = hit
@@ -227,8 +233,7 @@ class MovePlanning:
             return psi, 0.0
         kin = self.kin
         u0, n0 = kin.elbow_direction(start_q)
-        w = kin.wrist_of(flange) - kin.shoulder
-        u1 = w / max(float(np.linalg.norm(w)), 1e-12)
+        u1 = kin.wrist_direction(flange)
         if min(kin.reference_strength(u0), kin.reference_strength(u1)) > REL_ELBOW_CLEARANCE:
             return kin.angle_of(u0, n0) + turn, 0.0
         return None, turn
