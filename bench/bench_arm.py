@@ -1,7 +1,12 @@
 """Arm figures: move accept latency while moving (over DDS), PTP duration vs the analytic
 trapezoid, CP duration vs the TOPP-RA time-optimal bound, tracking in the simulation.
-Prints figures only (no timing asserts)."""
+Prints figures only (no timing asserts). The node runs as `bench.timed_node` (acti_middle_node
+with its move callbacks timed), so that the handler's own cost is printed beside the round trip's."""
+import json
 import math
+import os
+import shutil
+import tempfile
 import time
 
 import numpy as np
@@ -22,7 +27,9 @@ CPU_CALLS = 200   # accepts in a row whose CPU in the node is summed
 
 def accept_latency() -> None:
     ros = RosClient()
-    with running("bench.trigger_server"), running("acti_middle_node", "queue_size:=2000") as node:
+    handlers = os.path.join(tempfile.mkdtemp(), "handlers.json")   # bench.timed_node's
+    with running("bench.trigger_server"), \
+            running("bench.timed_node", "queue_size:=2000", args=(handlers,)) as node:
         ros.call(srv.ServoON, ARM + "servo_on")
         ros.call(srv.SetSpeedJoint, ARM + "set_speed_joint", spd_ratio=5)
         ros.call(srv.SetSpeedCartesian, ARM + "set_speed_cartesian", spd_ratio=5)
@@ -60,6 +67,9 @@ def accept_latency() -> None:
         cpu = {name: planning_cpu(node.proc.pid, fn) for name, fn in calls.items()
                if name != "get_state while moving"}
         moving = ros.call(srv.GetState, ARM + "get_state").state & 0x02
+    with open(handlers) as f:                      # written as the node ended
+        handler_times = json.load(f)
+    shutil.rmtree(os.path.dirname(handlers))
     table(f"round trip over DDS, {N} alternations (bare, call) for each call in {BLOCKS} blocks "
           f"spread over the run, arm moving: {bool(moving)} (real time)", pairs, "bare Trigger")
     table("the same calls against a bare server that answers the same messages at once "
@@ -70,6 +80,12 @@ def accept_latency() -> None:
           f"taking the request, the checks and the plan, the answer), {CPU_CALLS} accepts each:")
     for name, seconds in cpu.items():
         print(f"  {name:<42} {seconds * 1e6:7.0f} us")
+    print("the service callback alone in the node (the checks, the plan, the reply; every call "
+          "of the run), p50 of its thread's CPU and of its wall time:")
+    for service, calls in sorted(handler_times.items(), reverse=True):
+        cpu_s, wall_s = np.median(np.array(calls), axis=0)
+        print(f"  {service:<42} {cpu_s * 1e6:7.0f} us CPU  {wall_s * 1e6:7.0f} us wall"
+              f"   ({len(calls)} calls)")
     ros.close()
 
 
