@@ -114,3 +114,26 @@ def test_solve_many_chained_follows_the_turns_and_stops_at_the_first_doubt(kin):
     for F, d in zip(kin.flange_many(qs[:k]), dirs[:k]):
         seq.append(kin.solve(F, seq[-1], elbow_dir=d))
     assert np.max(np.abs(got[:k] - np.array(seq[1:]))) < 1e-9
+
+
+def test_the_elbow_direction_and_arm_angle_in_plain_floats_are_the_vectors_of_the_points(kin):
+    """elbow_direction, angle_of and wrist_direction (plain floats) against the same quantities
+    from the posture's points and flange with numpy, on random postures and a stretched arm;
+    a second call with the same posture answers the kept result, another posture a new one."""
+    rng = np.random.default_rng(11)
+    postures = [*rng.uniform(kin.lower * 0.95, kin.upper * 0.95, (100, 7)), np.zeros(7)]
+    for q in postures:
+        pts = kin.points(q)
+        u = (pts.wrist - pts.shoulder) / np.linalg.norm(pts.wrist - pts.shoulder)
+        v = pts.elbow - pts.shoulder
+        n = v - np.dot(v, u) * u
+        n = kin.reference(u)[0] if np.linalg.norm(n) < 1e-9 else n / np.linalg.norm(n)
+        got_u, got_n = kin.elbow_direction(q)
+        assert np.allclose(got_u, u, atol=1e-14) and np.allclose(got_n, n, atol=1e-12)
+        assert kin.elbow_direction(q.copy())[1] is got_n
+        e1, e2 = kin.reference(u)
+        assert kin.angle_of(u, n) == pytest.approx(math.atan2(np.dot(n, e2), np.dot(n, e1)),
+                                                   abs=1e-14)
+        w = kin.wrist_of(kin.flange(q)) - kin.shoulder
+        assert np.allclose(kin.wrist_direction(kin.flange(q)), w / np.linalg.norm(w), atol=1e-14)
+    assert kin.elbow_direction(START)[1] is not kin.elbow_direction(postures[0])[1]
