@@ -143,8 +143,23 @@ class SplineJointPath:
         self.ss, self.qs = ss, qs
         self.c = not_a_knot_coefficients(ss, qs) if c is None else c
         self.spline = PPoly.construct_fast(self.c, ss)
-        self.d1 = PPoly.construct_fast(self.c[:-1] * _D1, ss)   # PPoly.derivative's, unchecked
-        self.d2 = PPoly.construct_fast(self.c[:-2] * _D2, ss)
+        self._d1: PPoly | None = None
+        self._d2: PPoly | None = None
+
+    @property
+    def d1(self) -> PPoly:
+        """q'(s), built when first asked for (by the run, or by a timing check the bounds did
+        not settle): PPoly.derivative's coefficients, without its checks."""
+        if self._d1 is None:
+            self._d1 = PPoly.construct_fast(self.c[:-1] * _D1, self.ss)
+        return self._d1
+
+    @property
+    def d2(self) -> PPoly:
+        """q''(s), as `d1`."""
+        if self._d2 is None:
+            self._d2 = PPoly.construct_fast(self.c[:-2] * _D2, self.ss)
+        return self._d2
 
     def q(self, s: float) -> np.ndarray:
         return self.spline(s)
