@@ -16,7 +16,7 @@ from acti_motion.arm.trajectories import (TOPPRA_GRID, ArcPath, CartesianLimits,
                                           keeps_limits, not_a_knot_coefficients,
                                           not_a_knot_spline, poses_along, positions_along,
                                           samples_keep_limits, spline_within, time_optimal,
-                                          toppra_grid)
+                                          toppra_grid, unit_grid)
 from acti_motion.profiles import Trapezoid
 from acti_motion.replies import ReturnCode as R
 from sim_fixtures import executor  # noqa: F401
@@ -211,3 +211,8 @@ def test_the_spline_bound_says_within_only_where_every_point_is(kin):
     short = next(iter(splines))
     fine = short.spline(np.linspace(0.0, 1.0, 20001))
     assert spline_within(short, fine.min(axis=0) - 1e-3, fine.max(axis=0) + 1e-3)
+
+
+def test_the_unit_grid_is_linspace_to_the_last_bit():
+    for n in range(2, 400):
+        assert np.array_equal(unit_grid(n), np.linspace(0.0, 1.0, n))
