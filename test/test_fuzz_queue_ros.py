@@ -1,12 +1,13 @@
 """A queued move survives every request the spec does not make a stop, on both nodes over DDS.
 
-Each case queues a slow move (the base: 250 mm in about 1.5 s; the arm: a slow PTP), sends a
-few random requests to one service (its fields filled from the request type: good values
-beside NaN, inf, 1e308, 5e-324, zero and negative ones), puts the speed settings back (a
-request may have made the move crawl: that is allowed, a discard is not) and waits for the
-move: `wait_motion` must say completed. One table for both nodes: per node, how to make it
-ready, how to queue its slow move, and the services left out because the spec makes them a
-stop, a hold or a take-over (with the reason). Every other service of the node's operation
+Each case queues a slow move (the base: 250 mm in about 1.5 s; the arm: a slow PTP), in real
+time, waits until it runs, sends a few random requests to one service (its fields filled from
+the request type: good values beside NaN, inf, 1e308, 5e-324, zero and negative ones) while it
+runs, puts the speed settings back (a request may have made the move crawl: that is allowed, a
+discard is not) and waits for the move: `wait_motion` must say completed. One table for both nodes: per node, how to make it
+ready, how to queue its slow move, the services left out because the spec makes them a stop, a
+hold or a take-over (with the reason), and the fields held where only their other values stop
+(set_power and set_servo on: off is a stop). Every other service of the node's operation
 table is fuzzed. Seeds are fixed per service, so a failure repeats."""
 from __future__ import annotations
 
@@ -27,10 +28,10 @@ from acti_middle_node.operations import OPERATIONS as ARM_OPERATIONS
 from ros_harness import Actions, node_fixture, wait_until
 from vehicle_node.operations import OPERATIONS as BASE_OPERATIONS
 
-job = node_fixture("acti_bringup")
+job = node_fixture("acti_bringup", "real_time_factor:=1.0")   # the issue's pace: the requests land while the move runs
 
 ARM, BASE = "/acti_middle_node/", "/vehicle_node/"
-REQUESTS = 3                     # random requests per case
+REQUESTS = 5                     # random requests per case
 FLOATS_BAD = [math.nan, math.inf, -math.inf, 1e308, -1e308, 5e-324, 0.0, -1.0, -100.0]
 FLOATS_GOOD = [1.0, 5.0, 20.0, 50.0, 100.0, 300.0]
 INT_RANGES = {"int8": (-2**7, 2**7 - 1), "uint8": (0, 2**8 - 1), "int16": (-2**15, 2**15 - 1),
@@ -76,6 +77,7 @@ class Node:
     speed_back: Callable[[Any], None]
     wait_action: type
     left_out: dict[str, str]
+    fixed: dict[str, dict[str, Any]]          # fields held, where only their other values stop
 
 
 def call(ros, path: str, srv_type: type, **fields) -> Any:
@@ -136,13 +138,13 @@ NODES = {
     "base": Node(BASE, BASE_OPERATIONS, base_ready, base_slow_move, base_speed_back,
                  VehicleWaitMotion, {
                      "stop": "a stop (1.4.33)", "pause": "a hold until resume (1.4.22)",
-                     "set_power": "off is a stop", "set_servo": "off is a stop",
                      "move_jog": "takes over the running move (by design)",
-                     "move_continuous_rel": "takes over the running move (1.4.15)"}),
+                     "move_continuous_rel": "takes over the running move (1.4.15)"},
+                 {"set_power": {"on_off": True}, "set_servo": {"on_off": True}}),  # off stops
     "arm": Node(ARM, ARM_OPERATIONS, arm_ready, arm_slow_move, arm_speed_back, WaitMotion, {
         "stop": "a stop", "pause": "a hold until resume", "servo_off": "a stop",
         "set_soft_limit_joint": "a limit the arm is past stops it (alarm 0x4)",
-        "set_soft_limit_cartesian": "a limit the arm is past stops it (alarm 0x5)"}),
+        "set_soft_limit_cartesian": "a limit the arm is past stops it (alarm 0x5)"}, {}),
 }
 CASES = [(node, op.name) for node, n in NODES.items() for op in n.operations
          if op.name not in n.left_out]
@@ -156,13 +158,20 @@ def test_a_request_that_is_no_stop_keeps_the_queued_move(ros, job, node, service
     n.ready(ros)
     waits = Actions(ros, n.wait_action, n.path + "wait_motion")
     motion_id = n.slow_move(ros)
+    running: list[int] = []
+    wait = waits.send(lambda f: running.append(f.feedback.current_motion_id),
+                      motion_id=motion_id, timeout=120.0)
+    result = wait.get_result_async()
+    assert ros.spin_until(lambda: motion_id in running or result.done(), 30.0)
+    assert not result.done(), f"{node} motion {motion_id} was over before the requests"
     sent = []
-    for _ in range(REQUESTS):
-        fields = random_fields(srv_type, rng)
+    for _ in range(REQUESTS):                 # while the move runs
+        fields = random_fields(srv_type, rng) | n.fixed.get(service, {})
         sent.append(fields)
         ros.call(srv_type, n.path + service, **fields)
     n.speed_back(ros)
-    status, result = waits.result(waits.send(motion_id=motion_id, timeout=60.0))
+    assert ros.wait(result, 120.0)
+    result = result.result().result
     assert result.completed, (f"{node} motion {motion_id} discarded after {service} "
                               f"{sent}: {getattr(result, 'message', '')}")
     assert job.alive()
