@@ -14,6 +14,7 @@ from acti_motion.arm.poses import Frames, pose_to_hg
 from acti_motion.arm.trajectories import (TOPPRA_GRID, ArcPath, CartesianLimits, CartesianPlanner,
                                           LinePath, _pieces_at, bounds_keep_limits,
                                           keeps_limits, not_a_knot_coefficients,
+                                          not_a_knot_on_unit_grid,
                                           not_a_knot_spline, poses_along, positions_along,
                                           samples_keep_limits, spline_within, time_optimal,
                                           toppra_grid, unit_grid)
@@ -216,3 +217,17 @@ def test_the_spline_bound_says_within_only_where_every_point_is(kin):
 def test_the_unit_grid_is_linspace_to_the_last_bit():
     for n in range(2, 400):
         assert np.array_equal(unit_grid(n), np.linspace(0.0, 1.0, n))
+
+
+def test_the_spline_on_a_unit_grid_by_its_kept_map_is_the_solved_one():
+    """A CP plan's first samples (evenly spaced): the coefficients by the map kept per number
+    of points are those the system's solve gives, to rounding (within and beyond the kept
+    sizes)."""
+    rng = np.random.default_rng(5)
+    for n in range(4, 41):
+        ys = np.cumsum(rng.normal(size=(n, 7)), axis=0)
+        got, want = not_a_knot_on_unit_grid(ys), not_a_knot_coefficients(unit_grid(n), ys)
+        assert np.allclose(got, want, rtol=1e-10, atol=1e-10 * np.max(np.abs(want)))
+        assert np.array_equal(got[3], ys[:-1])                     # through the samples
+        still = not_a_knot_on_unit_grid(np.tile(ys[0], (n, 1)))      # a move that stays
+        assert not still[:3].any() and np.array_equal(still[3], np.tile(ys[0], (n - 1, 1)))

@@ -51,6 +51,7 @@ GRID_STEP_MM = 15.0       # TOPP-RA grid intervals: at most this much of the pat
 GRID_STEP_RAD = math.radians(3.0)   # and of a turn or of the joints' travel
 SAMPLE_FLOOR = 4          # least intervals of the IK samples of a CP path (more where it strays)
 ELBOW_GRID_FLOOR = 4      # least intervals of the grid the elbow is carried on along a CP path
+UNIT_GRID_MAPS = 32       # splines through up to this many evenly spaced samples: by a kept map
 NO_TURN = 1e-12           # rad: a line's rotation below this is rounding (R1·R0ᵀ of equal R)
 
 
@@ -122,6 +123,28 @@ def not_a_knot_coefficients(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
     c[2] = ds[:-1]
     c[3] = ys[:-1]
     return c
+
+
+def not_a_knot_on_unit_grid(ys: np.ndarray) -> np.ndarray:
+    """`not_a_knot_coefficients(unit_grid(len(ys)), ys)` (a CP plan's first samples): the
+    coefficients are linear in ys, so for up to UNIT_GRID_MAPS points by one product with
+    that map, solved once per number of points. The map takes ys less its first row (a
+    constant's derivatives are 0 then to the last bit, as the solve gives them: a move that
+    stays ends exactly where it starts) and the pieces start exactly at the samples."""
+    n = len(ys)
+    if n > UNIT_GRID_MAPS:
+        return not_a_knot_coefficients(unit_grid(n), ys)
+    c = np.empty((4, n - 1, ys.shape[1]))
+    c[:3] = _unit_grid_map(n) @ (ys - ys[0])
+    c[3] = ys[:-1]
+    return c
+
+
+@functools.lru_cache(maxsize=None)
+def _unit_grid_map(n: int) -> np.ndarray:
+    """(3 × n−1 × n): the x³, x², x coefficients of the splines through each unit vector on
+    unit_grid(n)."""
+    return not_a_knot_coefficients(unit_grid(n), np.eye(n))[:3].copy()
 
 
 def unit_grid(n: int) -> np.ndarray:
@@ -430,7 +453,7 @@ class CartesianPlanner:
         kin, ik = self.kin, _PathIK(self.kin, path, frames, elbow)
         count = 1 + max(SAMPLE_FLOOR, math.ceil(path.length / 0.02), math.ceil(path.angle / 0.1),
                         math.ceil(abs(elbow.turn) / 0.1))
-        ss = unit_grid(min(count, 200))
+        ss = first = unit_grid(min(count, 200))
         qs = ik.chain(ss, np.asarray(start_q, float))
         # refine where a joint steps too far (a fast joint near a singularity, or a branch jump)
         for _ in range(40):
@@ -443,7 +466,7 @@ class CartesianPlanner:
                 raise Unreachable("the path runs through a singularity (a joint would jump)")
         # refine where the spline strays from the path
         for _ in range(8):
-            c = not_a_knot_coefficients(ss, qs)
+            c = not_a_knot_on_unit_grid(qs) if ss is first else not_a_knot_coefficients(ss, qs)
             mids = (ss[:-1] + ss[1:]) / 2
             got = frames.tool_of(kin.flange_many(_pieces_at(c, mids - ss[:-1])))
             todo = np.flatnonzero(_strays(poses_along(path, mids), got))
