@@ -469,10 +469,10 @@ class CartesianPlanner:
             c = not_a_knot_on_unit_grid(qs) if ss is first else not_a_knot_coefficients(ss, qs)
             mids = (ss[:-1] + ss[1:]) / 2
             got = frames.tool_of(kin.flange_many(_pieces_at(c, mids - ss[:-1])))
-            todo = np.flatnonzero(_strays(poses_along(path, mids), got))
-            if not len(todo):
+            strays = _strays(poses_along(path, mids), got)
+            if not strays.any():
                 return SplineJointPath(ss, qs, c)
-            ss, qs = _insert(ss, qs, todo, ik.between)
+            ss, qs = _insert(ss, qs, np.flatnonzero(strays), ik.between)
         return SplineJointPath(ss, qs)
 
 
@@ -567,6 +567,8 @@ class _PathIK:
         """Joints at ss (ss[0] = 0 is start_q), each solved from the one before."""
         flanges, dirs = self._targets(ss[1:])
         batch, ok = self.kin.solve_many(flanges, dirs, start_q, chained=True)
+        if ok[-1]:                  # a leading run: all of them (a short line's usual case)
+            return np.concatenate([start_q[None], batch])
         qs = [start_q, *batch[ok]]
         for i in range(int(np.sum(ok)), len(flanges)):
             qs.append(self._one(ss[i + 1], flanges[i], dirs[i], qs[-1]))
