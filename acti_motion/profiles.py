@@ -6,10 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-
-def _floats(values: np.ndarray | list[float]) -> list[float]:
-    """A list as it is; an array (or a number) flattened into floats."""
-    return values if isinstance(values, list) else np.asarray(values, float).reshape(-1).tolist()
+from acti_motion.replies import floats
 
 
 @dataclass(frozen=True)
@@ -28,7 +25,7 @@ class Trapezoid:
         """Profile for axes moving `distance` at no more than `max_speed` each (same units; a
         speed of 0 for an axis that moves takes for ever). Plain floats: for a handful of axes
         numpy's per-call cost was most of a PTP accept's (lists of floats are taken as they are)."""
-        d, v = _floats(distance), _floats(max_speed)
+        d, v = floats(distance), floats(max_speed)
         if len(v) == 1:
             v = v * len(d)
         if not any(d):

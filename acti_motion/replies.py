@@ -102,18 +102,33 @@ def value_error(what: str) -> Refused:
     return Refused(ReturnCode.VALUE_ERR, what)
 
 
+def floats(values: np.ndarray | list[float]) -> list[float]:
+    """A list as it is; an array (or a number) flattened into floats. For a handful of values
+    plain floats cost less than numpy's calls (1 … 3 µs each on a cold core)."""
+    return values if isinstance(values, list) else np.asarray(values, float).reshape(-1).tolist()
+
+
+def finite_floats(values: Iterable[float], length: int | tuple[int, ...], name: str) -> list[float]:
+    """`values` as a list of floats of an allowed length, all finite, else VALUE_ERR. A list of
+    floats (what a ROS request's array is read as) is checked as it is, without numpy."""
+    if type(values) is list and all(type(x) is float for x in values):
+        got = list(values)
+    else:
+        got = np.asarray(values if isinstance(values, list) else list(values),
+                         dtype=float).reshape(-1).tolist()
+    allowed = (length,) if isinstance(length, int) else length
+    if len(got) not in allowed:
+        want = " or ".join(str(n) for n in allowed)
+        raise value_error(f"{name} needs {want} values, got {len(got)}")
+    if not all(map(math.isfinite, got)):
+        bad = [i for i, x in enumerate(got) if not math.isfinite(x)]
+        raise value_error(f"{name}[{bad[0]}] is {got[bad[0]]}: every value must be a finite number")
+    return got
+
+
 def finite_vector(values: Iterable[float], length: int | tuple[int, ...], name: str) -> np.ndarray:
     """`values` as a float vector of an allowed length with only finite numbers, else VALUE_ERR."""
-    v = np.asarray(values if isinstance(values, list) else list(values), dtype=float).reshape(-1)
-    allowed = (length,) if isinstance(length, int) else length
-    if len(v) not in allowed:
-        want = " or ".join(str(n) for n in allowed)
-        raise value_error(f"{name} needs {want} values, got {len(v)}")
-    floats = v.tolist()      # numpy's scalars one by one cost more than the rest of the check
-    if not all(map(math.isfinite, floats)):
-        bad = [i for i, x in enumerate(floats) if not math.isfinite(x)]
-        raise value_error(f"{name}[{bad[0]}] is {v[bad[0]]}: every value must be a finite number")
-    return v
+    return np.array(finite_floats(values, length, name))
 
 
 def finite_number(x: float, name: str) -> float:

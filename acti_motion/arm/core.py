@@ -37,8 +37,8 @@ from acti_motion.arm.settings import (BASE_OFFSET_MM, CONTROL_POINT_OFFSET_MM, M
 from acti_motion.arm.trajectories import ArcPath, ArmSetpoint, CartesianPlanner, LinePath
 from acti_motion.arm.watch import Alarm, AlarmType, SoftLimitWatch
 from acti_motion.executor import STOPPED, MotionExecutor
-from acti_motion.replies import (Refused, Reply, ReturnCode, finite_vector, plans, ratio_percent,
-                                 returns, value_error)
+from acti_motion.replies import (Refused, Reply, ReturnCode, finite_floats, finite_vector, plans,
+                                 ratio_percent, returns, value_error)
 from acti_sim.world import GRIPPER_JOINTS
 
 __all__ = ["ArmConfig", "ArmCore", "ArmSetpoint", "Alarm", "AlarmType"]
@@ -415,10 +415,12 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     @plans
     def move_ptp_joint_rel(self, joint_points: list[float]) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
-        step = finite_vector(joint_points, self.axis_count, "joint_points")
+        step = finite_floats(joint_points, self.axis_count, "joint_points")
         self._check_joint_step(step, "joint_points")
-        delta = np.radians(step)
-        return self.queue_joint_move(lambda start: start.joints + delta, "move_ptp_joint_rel")
+        delta = [math.radians(d) for d in step]
+        return self.queue_joint_move(
+            lambda start: [a + d for a, d in zip(start.joints.tolist(), delta)],
+            "move_ptp_joint_rel")
 
     @returns(*MOVE)
     @plans

@@ -18,14 +18,14 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from acti_motion.arm.kinematics import FEW_POSTURES, Unreachable, rotate_about
+from acti_motion.arm.kinematics import FEW_POSTURES, ArmKinematics, Unreachable, rotate_about
 from acti_motion.arm.poses import Frames
 from acti_motion.arm.trajectories import (ArmMotion, ArmSetpoint, CartesianLimits,
                                           CartesianPath, CartesianPlanner, LinearJointPath,
                                           LinePath, SplineJointPath, convex_checkpoints,
                                           positions_along, spline_within)
 from acti_motion.profiles import Trapezoid
-from acti_motion.replies import Refused, Reply, ReturnCode, value_error
+from acti_motion.replies import Refused, Reply, ReturnCode, floats, value_error
 
 R = ReturnCode
 
@@ -53,7 +53,7 @@ def _near_limits_refined(ss: np.ndarray, values: np.ndarray, evaluate: Callable[
     return np.vstack([values, evaluate(extra)])[order]
 
 
-def _well_inside(values: np.ndarray, bounds: np.ndarray, margin: float) -> bool:
+def _well_inside(values: np.ndarray | list[list[float]], bounds: np.ndarray, margin: float) -> bool:
     """Every row of a few samples (at most FEW_POSTURES) lies more than `margin` inside the
     bounds (rows: lower, upper): then no sample is near a limit (nothing to refine) and none
     is outside. In plain floats: on a cold core a short PTP move's numpy checks of its two
@@ -61,7 +61,26 @@ def _well_inside(values: np.ndarray, bounds: np.ndarray, margin: float) -> bool:
     if len(values) > FEW_POSTURES:
         return False
     box = [(lo + margin, hi - margin) for lo, hi in bounds.tolist()]
-    return all(lo < v < hi for row in values.tolist() for v, (lo, hi) in zip(row, box))
+    rows = values.tolist() if isinstance(values, np.ndarray) else values
+    return all(lo < v < hi for row in rows for v, (lo, hi) in zip(row, box))
+
+
+def _position_mm(pose: np.ndarray) -> list[float]:
+    """The position of a pose (4×4, m) in mm, in plain floats (one numpy call)."""
+    rows = pose.tolist()
+    return [rows[0][3] * 1000.0, rows[1][3] * 1000.0, rows[2][3] * 1000.0]
+
+
+def _line_positions_mm(kin: ArmKinematics, frames: Frames, q0: list[float], delta: list[float],
+                       ss: np.ndarray | list[float]) -> np.ndarray | list[list[float]]:
+    """The control point (mm, robot frame) at each s of the joint line q0 + s·delta (rad): a
+    few posture by posture in plain floats (a list of rows), more at once in numpy (an array)."""
+    if len(ss) <= FEW_POSTURES:
+        return [_position_mm(frames.tool_of(kin.flange(np.array([a + s * d for a, d in
+                                                                 zip(q0, delta)]))))
+                for s in ss]
+    qs = np.array(q0) + np.asarray(ss)[:, None] * np.array(delta)
+    return frames.tool_of(kin.flange_many(qs))[:, :3, 3] * 1000.0
 
 
 def _first_exit(values: np.ndarray, lower: np.ndarray, upper: np.ndarray,
@@ -91,21 +110,19 @@ class MovePlanning:
     _limit_rows: Callable[[], np.ndarray]
 
     # === checks ======================================================================================
-    def _check_joint_target(self, goal_deg: np.ndarray, name: str) -> None:
-        for i, (q, (a, b)) in enumerate(zip(np.asarray(goal_deg, float).tolist(),
-                                            self.soft_limit_joint.tolist())):
+    def _check_joint_target(self, goal_deg: np.ndarray | list[float], name: str) -> None:
+        for i, (q, (a, b)) in enumerate(zip(floats(goal_deg), self.soft_limit_joint.tolist())):
             if not a - 1e-9 <= q <= b + 1e-9:
                 raise value_error(f"{name}: J{i + 1} = {q:.10g}° is outside the soft limit "
                                   f"[{a:g}, {b:g}]°")
 
-    def _check_joint_step(self, step_deg: np.ndarray, name: str) -> None:
+    def _check_joint_step(self, step_deg: np.ndarray | list[float], name: str) -> None:
         """A relative step that takes no start within the hardware range into the soft limits
         is VALUE_ERR before the queue is looked at (a full queue would have hidden it). Only
         that: the arm may rest outside soft limits set since, and a step back in is a move.
         (Plain floats: on a cold core each numpy call of a PTP accept cost 10-25 µs.)"""
         soft, hard = self.soft_limit_joint.tolist(), self.hard_limit_joint.tolist()
-        for i, (d, (slo, shi), (hlo, hhi)) in enumerate(zip(np.asarray(step_deg, float).tolist(),
-                                                            soft, hard)):
+        for i, (d, (slo, shi), (hlo, hhi)) in enumerate(zip(floats(step_deg), soft, hard)):
             if not slo - hhi - 1e-9 <= d <= shi - hlo + 1e-9:
                 raise value_error(f"{name}: J{i + 1} by {d:g}° leaves the soft limit "
                                   f"[{slo:g}, {shi:g}]° from any start within its "
@@ -195,30 +212,34 @@ class MovePlanning:
             dense, joints_deg(dense), joints_deg, lim[:, 0], lim[:, 1], NEAR_LIMIT_DEG), label)
 
     # === queueing ======================================================================================
-    def queue_joint_move(self, goal_of: Callable[[ArmSetpoint], np.ndarray], label: str,
-                          speed_ratio: float | None = None, ramp: float | None = None) -> dict:
+    def queue_joint_move(self, goal_of: Callable[[ArmSetpoint], np.ndarray | list[float]],
+                         label: str, speed_ratio: float | None = None,
+                         ramp: float | None = None) -> dict:
         """A PTP move to goal_of(start) (rad): synchronized trapezoid at the joint speed ratio
-        and accel time (or the given ones: STROLIC programs keep their own)."""
+        and accel time (or the given ones: STROLIC programs keep their own). The 7 joints'
+        arithmetic is in plain floats (numpy's calls cost 1 … 3 µs each on a cold core)."""
         ratio = self.speed_joint if speed_ratio is None else speed_ratio
         speed = [math.radians(v) * ratio / 100.0 for v in self.max_speed_joint.tolist()]
         ramp = self.accel_time_joint if ramp is None else ramp
 
         def plan(start: ArmSetpoint) -> ArmMotion:
             frames = self.frames          # read while planning: the offsets wait for it
-            goal = goal_of(start)
-            self._check_joint_target(np.degrees(goal), label)
-            path = LinearJointPath(start.joints, goal)
-            delta = path.delta.tolist()
+            goal = floats(goal_of(start))
+            self._check_joint_target([math.degrees(g) for g in goal], label)
+            q0 = start.joints.tolist()
+            delta = [g - a for g, a in zip(goal, q0)]
+            path = LinearJointPath(start.joints, np.array(goal))
             steps = 1 + max(1, math.ceil(math.degrees(max(map(abs, delta)))))
-            ss = np.arange(steps) / (steps - 1)       # every degree of the longest joint's way
 
-            def positions_mm(ss: np.ndarray) -> np.ndarray:
-                qs = path.q0 + ss[:, None] * path.delta
-                return frames.tool_of(self.kin.flange_many(qs))[:, :3, 3] * 1000.0
-            lim, positions = self.soft_limit_cartesian, positions_mm(ss)
+            def positions_mm(ss: np.ndarray | list[float]) -> np.ndarray:
+                return np.asarray(_line_positions_mm(self.kin, frames, q0, delta, ss))
+            ss = [k / (steps - 1) for k in range(steps)]   # every degree of the longest joint's way
+            lim = self.soft_limit_cartesian
+            positions = _line_positions_mm(self.kin, frames, q0, delta, ss)
             if not _well_inside(positions, lim, NEAR_LIMIT_MM):
                 self._check_cartesian_positions(_near_limits_refined(
-                    ss, positions, positions_mm, lim[:, 0], lim[:, 1], NEAR_LIMIT_MM), label)
+                    np.array(ss), np.asarray(positions), positions_mm, lim[:, 0], lim[:, 1],
+                    NEAR_LIMIT_MM), label)
             timing = Trapezoid.for_axes(delta, speed, ramp)
             return ArmMotion(path, timing, start.finger, start.finger, ramp, "joint")
         return self._submit(plan, label)
