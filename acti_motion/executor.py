@@ -163,8 +163,15 @@ class Device:
     def submit(self, plan: Callable[[Any], Motion], label: str) -> int | None:
         """Plan a motion from the end of the last queued one and append it; its id, or None when
         the queue is full (`submit_all` of one)."""
-        ids = self.submit_all([(plan, label)])
-        return None if ids is None else ids[0]
+        got = self.submit_doomed(plan, label)
+        return None if got is None else got[0]
+
+    def submit_doomed(self, plan: Callable[[Any], Motion],
+                      label: str) -> tuple[int, str | None] | None:
+        """`submit`, with `doomed(id)` read under the hold of the lock that queued it (a move's
+        accept takes the lock once less); None when the queue is full."""
+        got = self._submit_all([(plan, label)])
+        return None if got is None else (got[0][0], got[1])
 
     def submit_all(self, plans: Sequence[tuple[Callable[[Any], Motion], str]]) -> list[int] | None:
         """Plan motions one after the other, each from the end of the one before (the first from
@@ -180,6 +187,12 @@ class Device:
         says so, and nothing of them runs. They arrive when this is called: planned, or waiting
         for another's plan, across the end of a stop, they were queued after it and ran.
         """
+        got = self._submit_all(plans)
+        return None if got is None else got[0]
+
+    def _submit_all(self, plans: Sequence[tuple[Callable[[Any], Motion], str]]
+                    ) -> tuple[list[int], str | None] | None:
+        """`submit_all`'s ids with why the last is doomed (`doomed`), read in the same hold."""
         arrived = self.arrival()
         with self._accept:
             while True:
@@ -196,7 +209,8 @@ class Device:
                         return None
                     if generation != self.generation or self.stopped_since(arrived):
                         if self.current is None and not self.queue:
-                            return [self._accept_discarded() for _ in plans]
+                            ids = [self._accept_discarded() for _ in plans]
+                            return ids, self._doomed(ids[-1]) if ids else None
                         if self._stop_at is None:
                             continue        # a halt's own motion runs: plan again from its end
                     ids = []
@@ -212,7 +226,7 @@ class Device:
                         self.queued_end = self._end_of_queue()
                     self.changed.notify_all()
                     self.wake()
-                    return ids
+                    return ids, self._doomed(ids[-1]) if ids else None
 
     def arrival(self) -> int:
         """A mark of now for `stopped_since`: a stop that decelerates now counts as one to come
@@ -409,10 +423,13 @@ class Device:
         """Why motion `motion_id` is, or will be, discarded: retired so, or accepted while a
         stop decelerates (it goes when the device rests); None otherwise."""
         with self.lock:
-            why = self._discards.reason(motion_id)
-            if why is None and self._stop_at is not None and motion_id > self.retired_id:
-                why = self._reason
-            return why
+            return self._doomed(motion_id)
+
+    def _doomed(self, motion_id: int) -> str | None:
+        why = self._discards.reason(motion_id)
+        if why is None and self._stop_at is not None and motion_id > self.retired_id:
+            why = self._reason
+        return why
 
     def status(self) -> tuple[int, str, float, int]:
         """(current motion id or 0, its label, its completed fraction, motions queued behind)."""

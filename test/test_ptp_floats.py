@@ -102,3 +102,15 @@ def test_the_queued_ptp_motion_is_the_numpy_formula_s(arm, step):  # noqa: F811
     speed = np.radians(arm.max_speed_joint) * arm.speed_joint / 100.0
     want = Trapezoid.for_axes((goal - start).tolist(), speed.tolist(), arm.accel_time_joint)
     assert motion.duration == want.duration
+
+
+def test_the_kept_posture_is_the_next_move_s_start_and_gives_the_same_position(arm):  # noqa: F811
+    """A PTP move's last posture is kept (`_position_at`); the next move starts at its end
+    (`path.q(1.0)`, the same floats) and finds it there: its position is what Pinocchio gives."""
+    kin, frames = shared_kinematics(), arm.frames
+    for step in ([0.5] * 7, [-0.5] * 7, [3.0, -2.0, 1.0, 0.0, 0.5, -0.25, 7.0]):
+        assert arm.move_ptp_joint_rel(step).ok
+        end = arm.device.queued_end.joints.tolist()
+        kept_frames, joints, position = arm._posture_memo
+        assert kept_frames is frames and joints == end
+        assert position == _line_positions_mm(kin, frames, end, [0.0] * 7, [0.0])[0]

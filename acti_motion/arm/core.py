@@ -113,6 +113,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
         self._inside: np.ndarray | None = None
         self._batch = threading.local()               # the moves an `all_or_nothing` collects
         self._cartesian_memo: tuple | None = None     # (joints sample, frames, its pose)
+        self._posture_memo = None                     # a PTP plan's last posture: `_position_at`
         executor.after_step(self._sample)
 
     def _apply_settings(self, c: ArmConfig) -> None:

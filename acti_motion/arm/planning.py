@@ -72,13 +72,17 @@ def _position_mm(pose: np.ndarray) -> list[float]:
 
 
 def _line_positions_mm(kin: ArmKinematics, frames: Frames, q0: list[float], delta: list[float],
-                       ss: np.ndarray | list[float]) -> np.ndarray | list[list[float]]:
+                       ss: np.ndarray | list[float],
+                       position_at: Callable[[list[float]], list[float]] | None = None
+                       ) -> np.ndarray | list[list[float]]:
     """The control point (mm, robot frame) at each s of the joint line q0 + s·delta (rad): a
-    few posture by posture in plain floats (a list of rows), more at once in numpy (an array)."""
+    few posture by posture in plain floats (a list of rows; `position_at`, if given, computes
+    one), more at once in numpy (an array)."""
     if len(ss) <= FEW_POSTURES:
-        return [_position_mm(frames.tool_of(kin.flange(np.array([a + s * d for a, d in
-                                                                 zip(q0, delta)]))))
-                for s in ss]
+        if position_at is None:
+            def position_at(q: list[float]) -> list[float]:
+                return _position_mm(frames.tool_of(kin.flange(np.array(q))))
+        return [position_at([a + s * d for a, d in zip(q0, delta)]) for s in ss]
     qs = np.array(q0) + np.asarray(ss)[:, None] * np.array(delta)
     return frames.tool_of(kin.flange_many(qs))[:, :3, 3] * 1000.0
 
@@ -108,6 +112,7 @@ class MovePlanning:
     _batch: threading.local               # the moves an `all_or_nothing` collects
     _check_can_move: Callable[..., None]
     _limit_rows: Callable[[], np.ndarray]
+    _posture_memo: tuple[Frames, list[float], list[float]] | None   # (frames, joints, position)
 
     # === checks ======================================================================================
     def _check_joint_target(self, goal_deg: np.ndarray | list[float], name: str) -> None:
@@ -231,11 +236,14 @@ class MovePlanning:
             path = LinearJointPath(start.joints, np.array(goal))
             steps = 1 + max(1, math.ceil(math.degrees(max(map(abs, delta)))))
 
+            def position_at(q: list[float]) -> list[float]:
+                return self._position_at(frames, q)
+
             def positions_mm(ss: np.ndarray | list[float]) -> np.ndarray:
-                return np.asarray(_line_positions_mm(self.kin, frames, q0, delta, ss))
+                return np.asarray(_line_positions_mm(self.kin, frames, q0, delta, ss, position_at))
             ss = [k / (steps - 1) for k in range(steps)]   # every degree of the longest joint's way
             lim = self.soft_limit_cartesian
-            positions = _line_positions_mm(self.kin, frames, q0, delta, ss)
+            positions = _line_positions_mm(self.kin, frames, q0, delta, ss, position_at)
             if not _well_inside(positions, lim, NEAR_LIMIT_MM):
                 self._check_cartesian_positions(_near_limits_refined(
                     np.array(ss), np.asarray(positions), positions_mm, lim[:, 0], lim[:, 1],
@@ -243,6 +251,17 @@ class MovePlanning:
             timing = Trapezoid.for_axes(delta, speed, ramp)
             return ArmMotion(path, timing, start.finger, start.finger, ramp, "joint")
         return self._submit(plan, label)
+
+    def _position_at(self, frames: Frames, q: list[float]) -> list[float]:
+        """The control point (mm) of posture q (rad) in `frames`; the last one computed is kept:
+        a PTP move ends where the next one queued starts (the very floats of `path.q(1.0)`),
+        so an accept of a short move computes one posture instead of two."""
+        memo = self._posture_memo
+        if memo is not None and memo[0] is frames and memo[1] == q:
+            return memo[2]
+        position = _position_mm(frames.tool_of(self.kin.flange(np.array(q))))
+        self._posture_memo = (frames, q, position)
+        return position
 
     def _elbow_goal(self, start_q: np.ndarray, flange: np.ndarray, psi: float | None,
                     turn: float) -> tuple[float | None, float]:
@@ -346,10 +365,10 @@ class MovePlanning:
         if collected is not None:
             collected.append((guarded, label))
             return {"motion_id": 0}
-        motion_id = self.device.submit(guarded, label)
-        if motion_id is None:
+        got = self.device.submit_doomed(guarded, label)
+        if got is None:
             raise self._full()
-        why = self.device.doomed(motion_id)
+        motion_id, why = got
         if why is not None:         # OK as 5.4.19 has it, and said: its wait will say the same
             return Reply(R.OK, f"discarded: {why} (a stop discards every command given until "
                                "the arm is at rest)", {"motion_id": motion_id})
