@@ -34,6 +34,7 @@ REACH_SAMPLES = 64                       # points of a CP path checked against t
 MAX_CHECK_SAMPLES = 20000                # points of a CP path checked against the soft limits
 NEAR_LIMIT_MM = 1.0      # samples this close to a Cartesian soft limit: checked between, finer
 NEAR_LIMIT_DEG = 0.01    # the same for a joint soft limit along a CP path's joint spline
+_NEAR_JOINT_LIMIT = np.array([NEAR_LIMIT_DEG, -NEAR_LIMIT_DEG])
 
 
 def _near_limits_refined(ss: np.ndarray, values: np.ndarray, evaluate: Callable[[np.ndarray], np.ndarray],
@@ -206,8 +207,8 @@ class MovePlanning:
         each piece keeps it clear of them (as the samples would find), else at 4 samples per
         IK sample, finer near a limit."""
         lim = self.soft_limit_joint
-        if spline_within(spline, np.radians(lim[:, 0] + NEAR_LIMIT_DEG),
-                         np.radians(lim[:, 1] - NEAR_LIMIT_DEG)):
+        clear = np.radians(lim + _NEAR_JOINT_LIMIT)      # rows: joints; lower, upper
+        if spline_within(spline, clear[:, 0], clear[:, 1]):
             return
         dense = np.linspace(0.0, 1.0, 4 * len(spline.ss))
 
@@ -312,10 +313,11 @@ class MovePlanning:
         v, w = self.max_speed_cartesian
         ratio = (self.speed_cartesian if speed_ratio is None else speed_ratio) / 100.0
         ramp = self.accel_time_cartesian if ramp is None else ramp
+        joint_velocity = np.radians(self.max_speed_joint)
         limits = CartesianLimits(
             speed=v * ratio / 1000.0, angular_speed=math.radians(w * ratio), ramp=ramp,
-            joint_velocity=np.radians(self.max_speed_joint),
-            joint_accel=np.radians(self.max_speed_joint) / self.min_accel_time_joint)
+            joint_velocity=joint_velocity,
+            joint_accel=joint_velocity / self.min_accel_time_joint)
 
         def plan(start: ArmSetpoint) -> ArmMotion:
             frames = self.frames          # read while planning: the offsets wait for it
