@@ -75,6 +75,7 @@ def test_the_recorded_tour_replayed_against_a_fresh_job_answers_every_call_equal
     finally:
         fresh.stop()
     out = replayed.stdout + replayed.stderr
+    print(out)                                  # the timing and the allowances used (-s)
     assert replayed.returncode == 0, out
     calls = int(out.split(" calls, ")[0].rsplit("\n", 1)[-1])
     assert out.rstrip().endswith(f"{calls} calls, 0 differences"), out
