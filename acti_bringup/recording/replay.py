@@ -209,9 +209,11 @@ class RequestReplay:
         """The recorded topics the running job listens to and does not publish itself (commands
         from outside: cmd_vel …): a publisher each, and the node listening (the device)."""
         publishers, devices = {}, {}
-        for channel in self.contents.channels:
-            if is_hidden(channel.topic):
-                continue
+        topics = [c for c in self.contents.channels if not is_hidden(c.topic)]
+        # the job's endpoints of each are in the graph (discovery comes a little later than
+        # the services'), unless the job has none
+        _wait(self.executor, lambda: all(self._endpoints(c.topic) for c in topics), MATCH_WAIT_S)
+        for channel in topics:
             listeners = [s for s in self.node.get_subscriptions_info_by_topic(channel.topic)
                          if s.node_name != self.node.get_name()]
             if listeners and not self.node.get_publishers_info_by_topic(channel.topic):
@@ -223,6 +225,12 @@ class RequestReplay:
         _wait(self.executor, lambda: all(p.get_subscription_count()
                                          for p in publishers.values()), MATCH_WAIT_S)
         return publishers, devices
+
+    def _endpoints(self, topic: str) -> list:
+        mine = self.node.get_name()
+        return [e for e in (*self.node.get_publishers_info_by_topic(topic),
+                            *self.node.get_subscriptions_info_by_topic(topic))
+                if e.node_name != mine]
 
     def _watch_the_job(self) -> None:
         """Subscribe to the job's clock and to the events of the services called (when the job
