@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 import threading
 from contextlib import contextmanager
-from typing import Callable, Iterator
+from typing import Any, Callable, Iterator
 
 import numpy as np
 
@@ -54,14 +54,16 @@ def _near_limits_refined(ss: np.ndarray, values: np.ndarray, evaluate: Callable[
     return np.vstack([values, evaluate(extra)])[order]
 
 
-def _well_inside(values: np.ndarray | list[list[float]], bounds: np.ndarray, margin: float) -> bool:
+def _well_inside(values: np.ndarray | list[list[float]], bounds: np.ndarray | list[list[float]],
+                 margin: float) -> bool:
     """Every row of a few samples (at most FEW_POSTURES) lies more than `margin` inside the
     bounds (rows: lower, upper): then no sample is near a limit (nothing to refine) and none
     is outside. In plain floats: on a cold core a short PTP move's numpy checks of its two
     samples cost ~25 µs of its accept; a longer path goes to numpy (False)."""
     if len(values) > FEW_POSTURES:
         return False
-    box = [(lo + margin, hi - margin) for lo, hi in bounds.tolist()]
+    box = [(lo + margin, hi - margin)
+           for lo, hi in (bounds.tolist() if isinstance(bounds, np.ndarray) else bounds)]
     rows = values.tolist() if isinstance(values, np.ndarray) else values
     return all(lo < v < hi for row in rows for v, (lo, hi) in zip(row, box))
 
@@ -113,11 +115,19 @@ class MovePlanning:
     _batch: threading.local               # the moves an `all_or_nothing` collects
     _check_can_move: Callable[..., None]
     _limit_rows: Callable[[], np.ndarray]
+    _for_limits: Callable[..., Any]
     _posture_memo: tuple[Frames, list[float], list[float]] | None   # (frames, joints, position)
 
     # === checks ======================================================================================
+    def _limit_floats(self) -> tuple[list[list[float]], list[list[float]], list[list[float]]]:
+        """The rows (lower, upper) of the joint soft limits (degree), the Cartesian soft limits
+        (mm) and the joints' hardware range (degree) as plain floats, made again only when a
+        limit was set: a PTP accept reads each (a numpy call apiece, 1 … 3 µs on a cold core)."""
+        return self._for_limits("_floats_made", lambda lj, lc: (
+            lj.tolist(), lc.tolist(), self.hard_limit_joint.tolist()))
+
     def _check_joint_target(self, goal_deg: np.ndarray | list[float], name: str) -> None:
-        for i, (q, (a, b)) in enumerate(zip(floats(goal_deg), self.soft_limit_joint.tolist())):
+        for i, (q, (a, b)) in enumerate(zip(floats(goal_deg), self._limit_floats()[0])):
             if not a - 1e-9 <= q <= b + 1e-9:
                 raise value_error(f"{name}: J{i + 1} = {q:.10g}° is outside the soft limit "
                                   f"[{a:g}, {b:g}]°")
@@ -127,7 +137,7 @@ class MovePlanning:
         is VALUE_ERR before the queue is looked at (a full queue would have hidden it). Only
         that: the arm may rest outside soft limits set since, and a step back in is a move.
         (Plain floats: on a cold core each numpy call of a PTP accept cost 10-25 µs.)"""
-        soft, hard = self.soft_limit_joint.tolist(), self.hard_limit_joint.tolist()
+        soft, _, hard = self._limit_floats()
         for i, (d, (slo, shi), (hlo, hhi)) in enumerate(zip(floats(step_deg), soft, hard)):
             if not slo - hhi - 1e-9 <= d <= shi - hlo + 1e-9:
                 raise value_error(f"{name}: J{i + 1} by {d:g}° leaves the soft limit "
@@ -245,7 +255,7 @@ class MovePlanning:
             ss = [k / (steps - 1) for k in range(steps)]   # every degree of the longest joint's way
             lim = self.soft_limit_cartesian
             positions = _line_positions_mm(self.kin, frames, q0, delta, ss, position_at)
-            if not _well_inside(positions, lim, NEAR_LIMIT_MM):
+            if not _well_inside(positions, self._limit_floats()[1], NEAR_LIMIT_MM):
                 self._check_cartesian_positions(_near_limits_refined(
                     np.array(ss), np.asarray(positions), positions_mm, lim[:, 0], lim[:, 1],
                     NEAR_LIMIT_MM), label)
