@@ -145,7 +145,8 @@ PROSE_CHECKS = {"drives the base while it publishes": moved_by_hand}
 
 def test_the_quick_tour_prints_what_its_comments_say(robot):
     tour = pasted_tour()
-    script = "\n".join(f"echo '{MARK}{n}'\n{bounded(c.text)}" for n, c in enumerate(tour))
+    script = "\n".join(f"echo '{MARK}{n}'\n{bounded(c.text, listeners=1)}"
+                       for n, c in enumerate(tour))
     outputs = re.split(rf"^{MARK}\d+\n", run_pasted(script), flags=re.M)[1:]
     assert len(outputs) == len(tour)
     checked = 0

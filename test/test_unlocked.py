@@ -166,8 +166,9 @@ def test_messages_arrive_as_they_were_when_handed_over(ros):
 
 def test_the_gil_is_free_while_rcl_sends():
     """rcl's sends are called as plain C functions, which ctypes calls with the GIL released: a
-    Python thread counts on during such a call (here a 0.2 s usleep), and next to nothing
-    during the same call made with the GIL held (as rclpy makes its calls)."""
+    Python thread counts on during such a call (here a 1 s usleep), and next to nothing
+    during the same call made with the GIL held (as rclpy makes its calls): only the few
+    milliseconds it may run before that call starts, small beside the second."""
     def counted_during(usleep) -> int:
         usleep.argtypes = (ctypes.c_uint,)
         counts, stop = [0], threading.Event()
@@ -179,7 +180,7 @@ def test_the_gil_is_free_while_rcl_sends():
         t.start()
         time.sleep(0.05)
         before = counts[0]
-        usleep(200_000)
+        usleep(1_000_000)
         during = counts[0] - before
         stop.set()
         t.join()
