@@ -225,7 +225,10 @@ class Device:
                     if self._stop_at is None:
                         self.queued_end = self._end_of_queue()
                     self.changed.notify_all()
-                    self.wake()
+                    if self.queue:
+                        # work for the loop; a motion over at once is none: an idle loop woken
+                        # for it stepped the steps it slept over while the answer went out
+                        self.wake()
                     return ids, self._doomed(ids[-1]) if ids else None
 
     def arrival(self) -> int:

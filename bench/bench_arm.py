@@ -23,6 +23,8 @@ IDENTITY = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
 ARM = "/acti_middle_node/"
 ARM_START = (0.0, 45.0, 0.0, -90.0, 0.0, 45.0, 0.0)
 CPU_CALLS = 200   # accepts in a row whose CPU in the node is summed
+WARMUP = 10       # calls of each block before its measured ones
+IDLE_CALLS = N + WARMUP * BLOCKS     # the idle arm's accepts (`idle_accepts`)
 
 
 def accept_latency() -> None:
@@ -58,15 +60,17 @@ def accept_latency() -> None:
             ros.call(srv.GetState, prefix + ARM + "get_state")
         calls = {"get_state while moving": state, "move_ptp_joint_rel accept": ptp,
                  "move_linear_cartesian_rel (20 mm) accept": cp}
-        pairs = paired(bare_call(ros), list(calls.items()), N, warmup=10, rounds=BLOCKS)
+        pairs = paired(bare_call(ros), list(calls.items()), N, warmup=WARMUP, rounds=BLOCKS)
         with running("bench.trigger_server",
                      args=("replay", *(ARM + op for op in ("get_state", "move_ptp_joint_rel",
                                                          "move_linear_cartesian_rel")))):
             same = paired({name: lambda fn=fn: fn(REPLAY) for name, fn in calls.items()},
-                          list(calls.items()), N, warmup=10, rounds=BLOCKS)
-        cpu = {name: planning_cpu(node.proc.pid, fn) for name, fn in calls.items()
-               if name != "get_state while moving"}
-        moving = ros.call(srv.GetState, ARM + "get_state").state & 0x02
+                          list(calls.items()), N, warmup=WARMUP, rounds=BLOCKS)
+            cpu = {name: planning_cpu(node.proc.pid, fn) for name, fn in calls.items()
+                   if name != "get_state while moving"}
+            moving = ros.call(srv.GetState, ARM + "get_state").state & 0x02
+            same.update(idle_accepts(ros))
+
     with open(handlers) as f:                      # written as the node ended
         handler_times = json.load(f)
     shutil.rmtree(os.path.dirname(handlers))
@@ -82,11 +86,30 @@ def accept_latency() -> None:
         print(f"  {name:<42} {seconds * 1e6:7.0f} us")
     print("the service callback alone in the node (the checks, the plan, the reply; every call "
           "of the run), p50 of its thread's CPU and of its wall time:")
+    ptp_calls = handler_times["move_ptp_joint_rel"]      # the idle arm's accepts came last
+    handler_times["move_ptp_joint_rel"] = ptp_calls[:-IDLE_CALLS]
+    handler_times["move_ptp_joint_rel, arm idle"] = ptp_calls[-IDLE_CALLS:]
     for service, calls in sorted(handler_times.items(), reverse=True):
         cpu_s, wall_s = np.median(np.array(calls), axis=0)
         print(f"  {service:<42} {cpu_s * 1e6:7.0f} us CPU  {wall_s * 1e6:7.0f} us wall"
               f"   ({len(calls)} calls)")
     ros.close()
+
+
+def idle_accepts(ros: RosClient) -> dict:
+    """A PTP accept on an idle arm (stopped, at rest: a move of 0°, which leaves it at rest)
+    against the same-type bare node (`REPLAY`, running): the accept that wakes the control
+    loop from its idle sleep, where a moving arm's finds it awake."""
+    name = "move_ptp_joint_rel accept, arm idle (0°)"
+    ros.call(srv.Stop, ARM + "stop")
+    assert ros.spin_until(lambda: not ros.call(srv.GetState, ARM + "get_state").state & 0x02,
+                          30.0), "the arm did not come to rest"
+
+    def ptp(prefix: str = "") -> None:
+        r = ros.call(srv.MovePTPJointRel, prefix + ARM + "move_ptp_joint_rel",
+                     joint_points=[0.0] * 7)
+        assert r.return_id.id == 0, r.return_id.comment
+    return paired({name: lambda: ptp(REPLAY)}, [(name, ptp)], N, warmup=WARMUP, rounds=BLOCKS)
 
 
 def planning_cpu(pid: int, call) -> float:

@@ -75,6 +75,21 @@ def test_work_wakes_an_idle_loop_at_once(loop):
     assert loop.steps - before >= 60
 
 
+def test_a_motion_over_at_once_leaves_an_idle_loop_asleep(loop):
+    """A zero-length motion on an idle device is over when it is accepted: nothing for the loop
+    to command, so it is not woken (woken, it stepped the steps it slept over back to back
+    while the accept's answer went out)."""
+    loop.IDLE_WAKE_S = LONG_WAKE_S
+    loop.start()
+    assert wait_for(lambda: loop.steps > 0, 2.0)
+    time.sleep(0.2)                             # asleep now, until LONG_WAKE_S
+    before = loop.steps
+    motion_id = loop.device.submit(lambda start: Hold(0.0), "nothing")
+    assert loop.device.retired_id == motion_id and loop.device.idle
+    time.sleep(0.5)
+    assert loop.steps == before
+
+
 def test_a_listener_that_must_be_on_time_keeps_its_rate_while_idle(loop):
     loop.IDLE_WAKE_S = LONG_WAKE_S
     calls = []
