@@ -44,6 +44,8 @@ setup:
 	$(SUBMAKE) -j2 stage-interfaces stage-wheels && \
 	$(STAGE) "the parameters list --help prints (kept in build/usage/)" $(SETUP_LOG)/usage.log \
 	  bash -c '$(ENV) && python -m acti_bringup --help' && \
+	$(STAGE) "the CP plan's compiled kernels (numba's cache)" $(SETUP_LOG)/kernels.log \
+	  bash -c '$(ENV) && python -m acti_motion.arm.compiled' && \
 	took=$$((SECONDS - start)) && printf 'setup done in %d:%02d\n' $$((took / 60)) $$((took % 60))
 
 stage-interfaces:

@@ -8,6 +8,7 @@ import pinocchio as pin
 import pytest
 
 from acti_motion.arm.core import shared_kinematics
+from acti_motion.arm.kinematics import FEW_POSTURES
 from acti_motion.arm.planning import _line_positions_mm
 from acti_motion.arm.poses import Frames
 from acti_motion.profiles import Trapezoid
@@ -61,9 +62,12 @@ def test_degrees_radians_and_the_goal_are_numpy_s(start, step):
 
 
 def positions_before(kin, frames, q0, delta, ss):
-    """The joint line's positions as they were computed before: every sample through numpy."""
+    """The joint line's positions as they were computed before: every sample through numpy,
+    a few postures' flanges by Pinocchio one by one, more at once (`flange_many`)."""
     qs = np.asarray(q0) + np.asarray(ss)[:, None] * np.asarray(delta)
-    return frames.tool_of(kin.flange_many(qs))[:, :3, 3] * 1000.0
+    flanges = (np.array([kin.flange(q) for q in qs]) if len(qs) <= FEW_POSTURES
+               else kin.flange_many(qs))
+    return frames.tool_of(flanges)[:, :3, 3] * 1000.0
 
 
 @pytest.mark.parametrize("offsets", [False, True])

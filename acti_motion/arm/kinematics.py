@@ -26,13 +26,14 @@ from itertools import product
 import numpy as np
 import pinocchio as pin
 
+from acti_motion.arm import compiled
+from acti_motion.arm.compiled import CLEAR
 from acti_sim.world import ARM_JOINTS, URDF_PATH
 
 TWO_PI = 2.0 * math.pi
 LATERAL_CONE = 1e-3           # rad: where S→W is this close to ±y, ψ is measured from ẑ × u
-CLEAR = 0.2                   # rad: θ2, θ4, θ6 this far from 0 leave no doubt about the branch
 _EPS = 1e-9
-FEW_POSTURES = 24             # up to this many, flange_many asks Pinocchio posture by posture
+FEW_POSTURES = 24             # up to this many postures, checks run in plain floats
 # Flags of CarPosWithElbow.struct_flag (reported; moves take the branch nearest the start).
 FLAG_SHOULDER = 0x1   # θ2 < 0
 FLAG_ELBOW = 0x2      # θ4 > 0
@@ -46,54 +47,12 @@ class Unreachable(ValueError):
     """No joint solution: the comment says why (too far, too close, joint limits)."""
 
 
-def rot_z_many(a: np.ndarray) -> np.ndarray:
-    """The rotation about z by each angle: (N, 3, 3)."""
-    c, s = np.cos(a), np.sin(a)
-    zero, one = np.zeros_like(c), np.ones_like(c)
-    return np.array([c, -s, zero, s, c, zero, zero, zero, one]).T.reshape(-1, 3, 3)
-
-
-def rot_zy_many(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Rotation about z by a[i], then about the new y by b[i], for each i: (N, 3, 3)."""
-    ca, sa, cb, sb = np.cos(a), np.sin(a), np.cos(b), np.sin(b)
-    return np.array([ca * cb, -sa, ca * sb, sa * cb, ca, sa * sb, -sb, np.zeros_like(ca),
-                     cb]).T.reshape(-1, 3, 3)
-
-
 def cross_many(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Cross products of 3-vectors, row-wise for (N, 3) arrays (np.cross costs more on small
     arrays)."""
     return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
                      a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
                      a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
-
-
-def rotate_many(axes: np.ndarray, angles: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Each vector v[i] (or the one v) turned by angles[i] about the unit axes[i] (Rodrigues)."""
-    c, s = np.cos(angles)[:, None], np.sin(angles)[:, None]
-    return (v * c + cross_many(axes, v) * s
-            + axes * ((axes * v).sum(axis=1)[:, None] * (1.0 - c)))
-
-
-def exp3_many(w: np.ndarray) -> np.ndarray:
-    """pin.exp3 of each rotation vector w[i]: (N, 3, 3)."""
-    angle = np.linalg.norm(w, axis=1)
-    k = w / np.maximum(angle, 1e-300)[:, None]
-    K = np.zeros((len(w), 3, 3))
-    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -k[:, 2], k[:, 1], -k[:, 0]
-    K = K - K.transpose(0, 2, 1)
-    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
-    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
-
-
-def _row_dots(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """The dot products of the rows of two (N, 3) arrays."""
-    return np.einsum("ij,ij->i", a, b)
-
-
-def _unit_clip(x: np.ndarray) -> np.ndarray:
-    """x within [-1, 1] (np.clip costs twice as much on a few values)."""
-    return np.minimum(np.maximum(x, -1.0), 1.0)
 
 
 def rotate_about(axis: np.ndarray, angle: float) -> np.ndarray:
@@ -174,27 +133,9 @@ class ArmKinematics:
 
     def flange_many(self, qs: np.ndarray) -> np.ndarray:
         """Flange poses (N×4×4, m) of many postures at once, from the SRS geometry read off the
-        model (the same poses as `flange`, without a Pinocchio call per posture). A few postures
-        (a short PTP move) go to Pinocchio one by one: ~1 µs each against ~25 µs of numpy."""
-        qs = np.asarray(qs, float)
-        if len(qs) <= FEW_POSTURES:
-            model, d, frame = self.model, self.data, self.flange_id
-            poses = []
-            for q in qs:
-                pin.forwardKinematics(model, d, q)
-                poses.append(pin.updateFramePlacement(model, d, frame).homogeneous)
-            return np.array(poses).reshape(-1, 4, 4)
-        R = rot_zy_many(qs[:, 0], qs[:, 1])
-        p = self.shoulder + self.upper_arm * R[:, :, 2]
-        R = R @ rot_zy_many(qs[:, 2], qs[:, 3])
-        p = p + self.forearm * R[:, :, 2]
-        R = R @ rot_zy_many(qs[:, 4], qs[:, 5])
-        p = p + self.hand * R[:, :, 2]
-        out = np.zeros((len(qs), 4, 4))
-        out[:, :3, :3] = R @ rot_z_many(qs[:, 6])
-        out[:, :3, 3] = p
-        out[:, 3, 3] = 1.0
-        return out
+        model (the same poses as `flange`, in one compiled call)."""
+        return compiled.flange_poses(np.asarray(qs, float).reshape(-1, 7), self.shoulder,
+                                     self.upper_arm, self.forearm, self.hand)
 
     def points(self, q: np.ndarray) -> ArmPoints:
         d = self.data
@@ -306,7 +247,7 @@ class ArmKinematics:
         lower = self.lower if lower is None else lower
         upper = self.upper if upper is None else upper
         ref = np.asarray(reference_q, float)
-        R, w = flange[:3, :3], self.wrist_of(flange)
+        w = self.wrist_of(flange)
         v = w - self.shoulder
         dist = float(np.linalg.norm(v))
         a, b = self.upper_arm, self.forearm
@@ -331,8 +272,8 @@ class ArmKinematics:
         # θ7 half a turn away: taking it swung the wrist 180°).
         signs = BRANCH_SIGNS * np.where(ref[1::2] < 0, -1.0, 1.0)
         q, inside = self._nearest_turns(
-            self._branch_many(np.broadcast_to(elbow, (8, 3)), np.broadcast_to(w, (8, 3)),
-                              np.broadcast_to(R, (8, 3, 3)), signs, ref), ref, lower, upper)
+            compiled.branches(elbow[None], w[None], flange[None], signs, ref[None],
+                              self.shoulder, a, b), ref, lower, upper)
         valid = np.flatnonzero(inside)
         if not len(valid):
             raise Unreachable("no joint solution within the joint limits for this pose and elbow")
@@ -356,54 +297,10 @@ class ArmKinematics:
         first nearest to `reference` (7), and only a leading run counts as solved; else each
         pose nearest to reference[i] (N×7). `solve` decides the others one by one (and says why
         where there is no solution)."""
-        a, b = self.upper_arm, self.forearm
-        w = self.wrist_of(flanges)
-        v = w - self.shoulder
-        dist = np.maximum(np.sqrt(_row_dots(v, v)), 1e-12)
-        u = v / dist[:, None]
-        h = (a * a - b * b + dist * dist) / (2 * dist)
-        rho = np.sqrt(np.maximum(a * a - h * h, 0.0))
-        n = elbow_dirs - _row_dots(elbow_dirs, u)[:, None] * u
-        n /= np.maximum(np.sqrt(_row_dots(n, n)), 1e-12)[:, None]
-        elbow = self.shoulder + h[:, None] * u + rho[:, None] * n
-        q = self._branch_many(elbow, w, flanges[:, :3, :3], np.sign(reference[..., 1::2]),
-                              reference)
-        if chained:     # each nearest the one before: whole turns that add up along the poses
-            steps = q - np.concatenate([reference[None], q[:-1]])
-            q = q - TWO_PI * np.rint(steps / TWO_PI).cumsum(axis=0)
-        else:
-            q = q + TWO_PI * np.rint((reference - q) / TWO_PI)
-        ok = ((dist <= self.reach + 1e-9) & (dist >= self.min_reach - 1e-9)
-              & (np.abs(q[:, 1::2]).min(axis=1) > CLEAR)
-              & (np.abs(reference[..., 1::2]).min(axis=-1) > CLEAR)
-              & ((q >= self.lower - 1e-9) & (q <= self.upper + 1e-9)).all(axis=1)
-              & self._reproduces(self.flange_many(q), flanges))
-        return q, np.logical_and.accumulate(ok) if chained else ok
-
-    def _branch_many(self, elbow: np.ndarray, wrist: np.ndarray, R: np.ndarray,
-                     signs: np.ndarray, ref: np.ndarray) -> np.ndarray:
-        """Joint angles of the branches with the signs (of θ2, θ4, θ6; N×3, or 3 for all) for
-        elbow and wrist points (N×3) and flange rotations (N×3×3). Where a branch is singular
-        (sin θ2, θ4 or θ6 near 0) the free angle is the reference's (ref: N×7, or 7 for all)."""
-        s2, s4, s6 = signs.T         # one sign each, or one per pose
-        ua = (elbow - self.shoulder) / self.upper_arm
-        t2 = np.arccos(_unit_clip(ua[:, 2]))
-        t1 = np.where(np.sin(t2) < 1e-9, ref[..., 0],
-                      np.arctan2(ua[:, 1], ua[:, 0]) + np.where(s2 < 0, math.pi, 0.0))
-        t2 = s2 * t2
-        f = (wrist - elbow) / self.forearm
-        r12 = rot_zy_many(t1, t2)
-        f2 = np.einsum("nji,nj->ni", r12, f)
-        t4 = s4 * np.arccos(_unit_clip(f2[:, 2]))
-        t3 = np.where(np.abs(np.sin(t4)) < 1e-9, ref[..., 2],
-                      np.arctan2(s4 * f2[:, 1], s4 * f2[:, 0]))
-        rw = (r12 @ rot_zy_many(t3, t4)).transpose(0, 2, 1) @ R
-        t6 = s6 * np.arccos(_unit_clip(rw[:, 2, 2]))
-        wrist_free = np.abs(np.sin(t6)) < 1e-9
-        t5 = np.where(wrist_free, ref[..., 4], np.arctan2(s6 * rw[:, 1, 2], s6 * rw[:, 0, 2]))
-        t7 = np.where(wrist_free, np.arctan2(rw[:, 1, 0], rw[:, 0, 0]) - ref[..., 4],
-                      np.arctan2(s6 * rw[:, 2, 1], -s6 * rw[:, 2, 0]))
-        return np.array([t1, t2, t3, t4, t5, t6, t7]).T
+        return compiled.solve_poses(
+            flanges, elbow_dirs, reference.reshape(-1, 7), chained, self.shoulder,
+            self.upper_arm, self.forearm, self.hand, self.reach, self.min_reach, self.lower,
+            self.upper)
 
     @staticmethod
     def _nearest_turns(q: np.ndarray, ref: np.ndarray, lower: np.ndarray,
@@ -417,13 +314,7 @@ class ArmKinematics:
         nearest = np.take_along_axis(options, pick[..., None], axis=-1)[..., 0]
         return nearest, np.all(np.any(inside, axis=-1), axis=-1)
 
-    @staticmethod
-    def _reproduces(got: np.ndarray, want: np.ndarray) -> np.ndarray:
-        """Whether each pose of `got` is `want`'s (…×4×4) up to rounding: the IK's self-check."""
-        d = np.abs(got[..., :3, :] - want[..., :3, :])
-        return (d[..., 3].max(axis=-1) <= 1e-7) & (d[..., :3].max(axis=(-2, -1)) <= 1e-6)
-
     def _verify(self, q: np.ndarray, flange: np.ndarray) -> None:
         got = self.flange(q)
-        if not self._reproduces(got, flange):
+        if not compiled.reproduces(got[None], flange[None])[0]:
             raise AssertionError(f"IK solution does not reproduce the pose:\n{got}\n{flange}")

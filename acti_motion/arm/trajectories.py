@@ -8,9 +8,10 @@ queue with the moves.
 CP moves sample the exact Cartesian path with the analytic IK (one solution per sample, each the
 nearest to the one before), refine the sampling until the joint spline reproduces the path
 within `PATH_TOLERANCE_MM` / `PATH_TOLERANCE_DEG`, and check the soft limits on the result.
-Planning runs on the service thread before a move is accepted, so it is vectorised: the IK of
-all samples at once where the branch is beyond doubt (`ArmKinematics.solve_many`), one by one
-near a branch boundary; the same samples and joints either way. Its cost is bounded: at most
+Planning runs on the service thread before a move is accepted, so its arithmetic on the
+samples is compiled (`acti_motion.arm.compiled`, a call per stage): the IK of all samples at
+once where the branch is beyond doubt (`ArmKinematics.solve_many`), one by one near a branch
+boundary; the same samples and joints either way. Its cost is bounded: at most
 200 first samples, refinement to `MAX_SAMPLES`, a TOPP-RA grid sized by the path (at most
 `TOPPRA_GRID` points), and paths longer than any within the arm's reach refused before they are
 sampled (`CartesianPlanner.check_length`).
@@ -29,8 +30,8 @@ import toppra as ta     # at start-up: the import takes most of a second, never 
 from scipy.interpolate import PPoly
 from scipy.linalg import lapack
 
-from acti_motion.arm.kinematics import (ArmKinematics, Unreachable, exp3_many, rotate_many,
-                                        wrap)
+from acti_motion.arm import compiled
+from acti_motion.arm.kinematics import ArmKinematics, Unreachable, wrap
 from acti_motion.arm.poses import Frames
 from acti_motion.profiles import Trapezoid
 from acti_sim.world import World
@@ -43,6 +44,8 @@ ta.solverwrapper.available_solvers = functools.lru_cache(maxsize=None)(
 
 PATH_TOLERANCE_MM = 0.02
 PATH_TOLERANCE_DEG = 0.01
+STRAY_M2 = (PATH_TOLERANCE_MM / 1000.0) ** 2      # the tolerances as `compiled.strays` takes them
+STRAY_COS = math.cos(math.radians(PATH_TOLERANCE_DEG))
 MAX_JOINT_STEP = math.radians(2.0)   # between IK samples of a CP path
 MAX_SAMPLES = 4000
 TOPPRA_GRID = 201         # most grid points of TOPP-RA (`toppra_grid` sizes it by the path)
@@ -291,17 +294,13 @@ class LinePath:
 
     def positions(self, ss: np.ndarray) -> np.ndarray:
         """Positions at each s (N×3)."""
-        return self.p0 + np.asarray(ss, float)[:, None] * self.dp
+        return compiled.line_positions(self.p0, self.dp, np.asarray(ss, float))
 
     def poses(self, ss: np.ndarray) -> np.ndarray:
         """Poses at each s (N×4×4)."""
         ss = np.asarray(ss, float)
-        T = np.zeros((len(ss), 4, 4))
-        turns = self.angle > NO_TURN
-        T[:, :3, :3] = exp3_many(ss[:, None] * self.w) @ self.R0 if turns else self.R0
-        T[:, :3, 3] = self.positions(ss)
-        T[:, 3, 3] = 1.0
-        return T
+        return compiled.geodesic_poses(self.R0, self.w, self.angle > NO_TURN, ss,
+                                       self.positions(ss))
 
     def position(self, s: float) -> np.ndarray:
         return self.positions(np.array([s]))[0]
@@ -336,8 +335,8 @@ class ArcPath(LinePath):
 
     def positions(self, ss: np.ndarray) -> np.ndarray:
         ss = np.asarray(ss, float)
-        axes = np.broadcast_to(self.normal, (len(ss), 3))
-        return self.center + rotate_many(axes, ss * self.sweep, self._r0)
+        return self.center + compiled.rotate_rows(self.normal[None], ss * self.sweep,
+                                                  self._r0[None])
 
 
 def _own(path: CartesianPath) -> TypeGuard[LinePath]:
@@ -434,16 +433,8 @@ class CartesianPlanner:
         kin = self.kin
         grid = unit_grid(1 + min(128, max(ELBOW_GRID_FLOOR, math.ceil(path.length / 0.005),
                                           math.ceil(path.angle / 0.02))))
-        us = _units(kin.wrist_of(to_flange(poses_along(path, grid))) - kin.shoulder)
-        n = kin.elbow_direction(start_q)[1].tolist()
-        ns = []
-        for u in us.tolist():              # plain floats: a short recurrence, numpy is slower
-            d = n[0] * u[0] + n[1] * u[1] + n[2] * u[2]
-            n = [n[0] - d * u[0], n[1] - d * u[1], n[2] - d * u[2]]
-            norm = math.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
-            n = [n[0] / norm, n[1] / norm, n[2] / norm]
-            ns.append(n)
-        ns = np.array(ns)
+        us, ns = compiled.carry_elbow(to_flange(poses_along(path, grid)),
+                                      kin.elbow_direction(start_q)[1], kin.shoulder, kin.hand)
         if psi is not None:
             turn = wrap(psi - kin.angle_of(us[-1], ns[-1]))
         return _ElbowPlan(grid, ns, turn)
@@ -469,7 +460,7 @@ class CartesianPlanner:
             c = not_a_knot_on_unit_grid(qs) if ss is first else not_a_knot_coefficients(ss, qs)
             mids = (ss[:-1] + ss[1:]) / 2
             got = frames.tool_of(kin.flange_many(_pieces_at(c, mids - ss[:-1])))
-            strays = _strays(poses_along(path, mids), got)
+            strays = compiled.strays(poses_along(path, mids), got, STRAY_M2, STRAY_COS)
             if not strays.any():
                 return SplineJointPath(ss, qs, c)
             ss, qs = _insert(ss, qs, np.flatnonzero(strays), ik.between)
@@ -502,27 +493,16 @@ def bounds_keep_limits(spline: SplineJointPath, nominal: Trapezoid,
     linear, on [0, h]), ṡ ≤ the profile's peak v and |s̈| ≤ v / ramp, the joint velocity q'ṡ is
     within M1·v and the acceleration q''ṡ² + q's̈ within M2·v² + M1·v / ramp. Where these
     bounds keep the limits, so does every sample the full check would take."""
-    if nominal.ramp <= 0.0:
-        return False
-    c = np.abs(spline.c)                         # (4, pieces, dof): x³, x², x, 1 coefficients
-    h = (spline.ss[1:] - spline.ss[:-1])[:, None]
-    m1 = (c[2] + h * (2.0 * c[1] + 3.0 * h * c[0])).max(axis=0)
-    m2 = (2.0 * c[1] + 6.0 * h * c[0]).max(axis=0)
-    v = nominal.peak
-    return bool((m1 * v <= limits.joint_velocity).all()
-                and (m2 * v * v + m1 * v / nominal.ramp <= limits.joint_accel).all())
+    return nominal.ramp > 0.0 and compiled.bounds_keep(
+        spline.c, spline.ss, nominal.peak, nominal.ramp, limits.joint_velocity,
+        limits.joint_accel)
 
 
 def spline_within(spline: SplineJointPath, lower: np.ndarray, upper: np.ndarray) -> bool:
     """Whether a cubic spline stays within [lower, upper] (per axis) between its first and last
     breakpoints, by a bound per piece: q(x) = c₃ + c₂x + x²(c₁ + c₀x) on [0, h] is within
     h²(|c₁| + h|c₀|) of the chord c₃ + c₂x. A sufficient condition: False says nothing."""
-    c = spline.c
-    h = (spline.ss[1:] - spline.ss[:-1])[:, None]
-    bend = h * h * (np.abs(c[1]) + h * np.abs(c[0]))
-    end = c[3] + h * c[2]
-    return bool((np.minimum(c[3], end) - bend >= lower).all()
-                and (np.maximum(c[3], end) + bend <= upper).all())
+    return compiled.within(spline.c, spline.ss, lower, upper)
 
 
 @dataclass
@@ -531,14 +511,11 @@ class _ElbowPlan:
     base: np.ndarray     # transported elbow directions on the grid
     turn: float
 
-    def directions(self, ss: np.ndarray, us: np.ndarray) -> np.ndarray:
-        """The elbow direction at each s, normal to the shoulder-wrist direction us[i] there."""
-        last = len(self.grid) - 1
-        i = np.minimum((ss * last).astype(int), last - 1)
-        f = ((ss - self.grid[i]) / (self.grid[i + 1] - self.grid[i]))[:, None]
-        n = (1 - f) * self.base[i] + f * self.base[i + 1]
-        n = _units(n - np.einsum("ij,ij->i", n, us)[:, None] * us)
-        return rotate_many(us, self.turn * ss, n) if self.turn else n
+    def directions(self, ss: np.ndarray, flanges: np.ndarray, kin: ArmKinematics) -> np.ndarray:
+        """The elbow direction at each s (flange poses there: N×4×4), normal to the
+        shoulder-wrist direction there."""
+        return compiled.elbow_directions(flanges, ss, self.grid, self.base, self.turn,
+                                         kin.shoulder, kin.hand)
 
 
 class _PathIK:
@@ -553,8 +530,7 @@ class _PathIK:
 
     def _targets(self, ss: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         flanges = self.frames.flange_of(poses_along(self.path, ss))
-        us = _units(self.kin.wrist_of(flanges) - self.kin.shoulder)
-        return flanges, self.elbow.directions(ss, us)
+        return flanges, self.elbow.directions(ss, flanges, self.kin)
 
     def _one(self, s: float, flange: np.ndarray, elbow_dir: np.ndarray,
              ref: np.ndarray) -> np.ndarray:
@@ -654,21 +630,3 @@ def _insert(ss: np.ndarray, qs: np.ndarray, where: np.ndarray,
     mids = (ss[where] + ss[where + 1]) / 2
     return np.insert(ss, where + 1, mids), np.insert(qs, where + 1, solve(mids, qs[where]), axis=0)
 
-
-STRAY_M2 = (PATH_TOLERANCE_MM / 1000.0) ** 2
-STRAY_COS = math.cos(math.radians(PATH_TOLERANCE_DEG))
-
-
-def _strays(want: np.ndarray, got: np.ndarray) -> np.ndarray:
-    """Which poses of `got` miss those of `want` (N×4×4 each) by more than the path tolerance:
-    the rotation between them turns by more than the angle whose cosine is (trace − 1) / 2, and
-    the trace of got·wantᵀ is the sum of their elements' products (a few numpy calls: this runs
-    on every refinement of every CP plan)."""
-    d = want[:, :3, 3] - got[:, :3, 3]
-    cos = (np.einsum("nij,nij->n", got[:, :3, :3], want[:, :3, :3]) - 1.0) / 2
-    return (np.einsum("ni,ni->n", d, d) > STRAY_M2) | (cos < STRAY_COS)
-
-
-def _units(v: np.ndarray) -> np.ndarray:
-    """The rows of v (N×3) scaled to length 1."""
-    return v / np.sqrt(np.einsum("ij,ij->i", v, v))[:, None]
