@@ -9,10 +9,11 @@ import pinocchio as pin
 import pytest
 from scipy.interpolate import CubicSpline
 
+from acti_motion.arm import compiled
 from acti_motion.arm.core import ArmConfig, ArmCore, shared_kinematics
 from acti_motion.arm.poses import Frames, pose_to_hg
 from acti_motion.arm.trajectories import (TOPPRA_GRID, ArcPath, CartesianLimits, CartesianPlanner,
-                                          LinePath, _pieces_at, bounds_keep_limits,
+                                          LinePath, bounds_keep_limits,
                                           keeps_limits, not_a_knot_coefficients,
                                           not_a_knot_on_unit_grid,
                                           not_a_knot_spline, poses_along, positions_along,
@@ -160,7 +161,7 @@ def test_the_joint_spline_is_scipy_s_not_a_knot_cubic_spline(n):
     ts = np.linspace(-0.01, 1.01, 301)                 # extrapolates like CubicSpline too
     assert np.allclose(ours(ts), theirs(ts), rtol=1e-12, atol=1e-12)
     mids = (xs[:-1] + xs[1:]) / 2                      # the pieces at their middles at once
-    assert np.allclose(_pieces_at(not_a_knot_coefficients(xs, ys), mids - xs[:-1]),
+    assert np.allclose(compiled.spline_middles(not_a_knot_coefficients(xs, ys), xs),
                        theirs(mids), rtol=1e-12, atol=1e-12)
 
 

@@ -293,6 +293,46 @@ def test_the_kernels_load_from_the_cache_and_never_compile_again():
             "sum(k.stats.cache_misses.__len__() for k in ks), time.process_time() - t)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout.split()
-    assert int(out[0]) == 12 and out[1] == "True" and out[2] == "0", out
+    assert int(out[0]) == 17 and out[1] == "True" and out[2] == "0", out
     with pytest.raises(TypeError):
         compiled.line_positions(np.zeros(3, dtype=np.float32), np.zeros(3), np.zeros(2))
+
+
+def test_the_spline_s_middles_and_steps_are_the_numpy_formula_s(kin):
+    """spline_strays: the middles' flange poses, as control-point poses with and without
+    offsets, against the path's poses there; long_steps: the intervals with a joint step
+    beyond the bound; line_poses: a line's positions and rotations in one call."""
+    from acti_motion.arm.trajectories import not_a_knot_coefficients
+    rng = np.random.default_rng(12)
+    base, tool = np.eye(4), np.eye(4)
+    base[:3, :3], base[:3, 3] = pin.exp3(np.radians([3.0, -4.0, 30.0])), [0.01, -0.02, 0.005]
+    tool[:3, :3], tool[:3, 3] = pin.exp3(np.radians([0.0, 10.0, 0.0])), [0.0, 0.015, 0.12]
+    seen = set()
+    for q in postures(kin, n=30)[::3]:
+        ss = np.concatenate([[0.0], np.sort(rng.uniform(0, 1, 5)), [1.0]])
+        bend = rng.choice([0.0, 1e-3])            # off the line between the samples, or not
+        qs = q + ss[:, None] * rng.normal(0, 0.3, 7) + bend * np.sin(7 * ss)[:, None]
+        c = not_a_knot_coefficients(ss, qs)
+        mids = (ss[:-1] + ss[1:]) / 2
+        t = (mids - ss[:-1])[:, None]
+        middles = c[3] + t * (c[2] + t * (c[1] + t * c[0]))
+        assert np.max(np.abs(compiled.spline_middles(c, ss) - middles)) < 1e-15
+        for to_robot, flange_to_tool in ((np.eye(4), np.eye(4)), (np.linalg.inv(base), tool)):
+            got = to_robot @ flange_many(kin, middles) @ flange_to_tool
+            want = to_robot @ flange_many(kin, q + mids[:, None] * (qs[-1] - q)) @ flange_to_tool
+            d = want[:, :3, 3] - got[:, :3, 3]
+            cos = (np.einsum("nij,nij->n", got[:, :3, :3], want[:, :3, :3]) - 1.0) / 2
+            expect = (rows_dot(d, d) > STRAY_M2) | (cos < STRAY_COS)
+            assert np.array_equal(compiled.spline_strays(
+                c, ss, want, to_robot, flange_to_tool, kin.shoulder, kin.upper_arm,
+                kin.forearm, kin.hand, STRAY_M2, STRAY_COS), expect)
+            seen.update(expect.tolist())
+        steps = np.abs(qs[1:] - qs[:-1])
+        for bound in (0.0, float(np.median(steps)), 10.0):
+            assert np.array_equal(compiled.long_steps(qs, bound),
+                                  np.flatnonzero(steps.max(axis=1) > bound))
+        p0, dp, R0, w = rng.normal(0, 1, 3), rng.normal(0, 1, 3), pin.exp3(q[:3]), q[3:6]
+        assert np.array_equal(compiled.line_poses(p0, dp, R0, w, True, ss),
+                              compiled.geodesic_poses(R0, w, True, ss,
+                                                      compiled.line_positions(p0, dp, ss)))
+    assert seen == {False, True}

@@ -50,6 +50,16 @@ def _mat3(A: np.ndarray, B: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True, inline="always")
+def _mat4(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    out = np.empty((4, 4))
+    for i in range(4):
+        for j in range(4):
+            out[i, j] = (A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j]
+                         + A[i, 3] * B[3, j])
+    return out
+
+
+@njit(cache=True, inline="always")
 def _clip_unit(x: float) -> float:
     return min(max(x, -1.0), 1.0)
 
@@ -305,7 +315,14 @@ def geodesic_poses(R0: np.ndarray, w: np.ndarray, turns: bool, ss: np.ndarray,
     return out
 
 
-# --- the joint spline's checks --------------------------------------------------------------------
+@_kernel(float64[:, :, ::1](_A1, _A1, _A2, _A1, boolean, _A1))
+def line_poses(p0: np.ndarray, dp: np.ndarray, R0: np.ndarray, w: np.ndarray, turns: bool,
+               ss: np.ndarray) -> np.ndarray:
+    """A line's poses at each s: `geodesic_poses` at `line_positions`."""
+    return geodesic_poses(R0, w, turns, ss, line_positions(p0, dp, ss))
+
+
+# --- the joint spline and its checks --------------------------------------------------------------------
 @_kernel(boolean[::1](_A3, _A3, float64, float64))
 def strays(want: np.ndarray, got: np.ndarray, max_m2: float, min_cos: float) -> np.ndarray:
     """Which poses of `got` miss those of `want` (N×4×4 each): by more than √max_m2 in
@@ -321,6 +338,66 @@ def strays(want: np.ndarray, got: np.ndarray, max_m2: float, min_cos: float) -> 
                 trace += got[i, r, c] * want[i, r, c]
         out[i] = d2 > max_m2 or (trace - 1.0) / 2 < min_cos
     return out
+
+
+@_kernel(float64[:, :, ::1](_A3, _A2))
+def unit_grid_coefficients(unit_map: np.ndarray, ys: np.ndarray) -> np.ndarray:
+    """The not-a-knot spline's coefficients (4 × pieces × dof, highest power first) through ys
+    on an even grid, by its linear map (3 × pieces × points, the spline of each unit vector):
+    the map applied to ys less its first row, and the pieces starting at the samples."""
+    n, dof = ys.shape
+    c = np.empty((4, n - 1, dof))
+    for k in range(n - 1):
+        for j in range(dof):
+            for p in range(3):
+                total = 0.0
+                for i in range(n):
+                    total += unit_map[p, k, i] * (ys[i, j] - ys[0, j])
+                c[p, k, j] = total
+            c[3, k, j] = ys[k, j]
+    return c
+
+
+@_kernel(float64[:, ::1](_A3, _A1))
+def spline_middles(c: np.ndarray, ss: np.ndarray) -> np.ndarray:
+    """The cubic spline (coefficients c, breakpoints ss) at the middle of each piece."""
+    out = np.empty((c.shape[1], c.shape[2]))
+    for k in range(c.shape[1]):
+        t = (ss[k] + ss[k + 1]) / 2 - ss[k]
+        for j in range(c.shape[2]):
+            out[k, j] = c[3, k, j] + t * (c[2, k, j] + t * (c[1, k, j] + t * c[0, k, j]))
+    return out
+
+
+@_kernel(boolean[::1](_A3, _A1, _A3, _A2, _A2, _A1, float64, float64, float64, float64,
+                      float64))
+def spline_strays(c: np.ndarray, ss: np.ndarray, want: np.ndarray, to_robot: np.ndarray,
+                  tool: np.ndarray, shoulder: np.ndarray, upper_arm: float, forearm: float,
+                  hand: float, max_m2: float, min_cos: float) -> np.ndarray:
+    """Which pieces of a joint spline miss the path at their middles (`want`: the path's
+    control-point poses there) by more than `strays` lets through: the flange poses of the
+    middles (`flange_poses`) as control-point poses, to_robot · F · tool (the frames' offsets:
+    a product with identities is exact)."""
+    flanges = flange_poses(spline_middles(c, ss), shoulder, upper_arm, forearm, hand)
+    got = np.empty_like(flanges)
+    for i in range(len(flanges)):
+        got[i] = _mat4(_mat4(to_robot, flanges[i]), tool)
+    return strays(want, got, max_m2, min_cos)
+
+
+@_kernel(types.int64[::1](_A2, float64))
+def long_steps(qs: np.ndarray, largest: float) -> np.ndarray:
+    """The intervals between the rows of qs in which some joint steps by more than `largest`."""
+    out = np.empty(len(qs) - 1, dtype=np.int64)
+    count = 0
+    for k in range(len(qs) - 1):
+        step = 0.0
+        for j in range(qs.shape[1]):
+            step = max(step, abs(qs[k + 1, j] - qs[k, j]))
+        if step > largest:
+            out[count] = k
+            count += 1
+    return out[:count].copy()
 
 
 @_kernel(boolean(_A3, _A1, float64, float64, _A1, _A1))

@@ -137,10 +137,7 @@ def not_a_knot_on_unit_grid(ys: np.ndarray) -> np.ndarray:
     n = len(ys)
     if n > UNIT_GRID_MAPS:
         return not_a_knot_coefficients(unit_grid(n), ys)
-    c = np.empty((4, n - 1, ys.shape[1]))
-    c[:3] = _unit_grid_map(n) @ (ys - ys[0])
-    c[3] = ys[:-1]
-    return c
+    return compiled.unit_grid_coefficients(_unit_grid_map(n), ys)
 
 
 @functools.lru_cache(maxsize=None)
@@ -156,12 +153,6 @@ def unit_grid(n: int) -> np.ndarray:
     grid = np.arange(n, dtype=float) * (1.0 / (n - 1))
     grid[-1] = 1.0
     return grid
-
-
-def _pieces_at(c: np.ndarray, offsets: np.ndarray) -> np.ndarray:
-    """Each piece of the cubic spline with coefficients c at its own offset from its start."""
-    t = offsets[:, None]
-    return c[3] + t * (c[2] + t * (c[1] + t * c[0]))
 
 
 _D1 = np.array([3.0, 2.0, 1.0])[:, None, None]    # a cubic's coefficients → its derivatives
@@ -298,9 +289,8 @@ class LinePath:
 
     def poses(self, ss: np.ndarray) -> np.ndarray:
         """Poses at each s (N×4×4)."""
-        ss = np.asarray(ss, float)
-        return compiled.geodesic_poses(self.R0, self.w, self.angle > NO_TURN, ss,
-                                       self.positions(ss))
+        return compiled.line_poses(self.p0, self.dp, self.R0, self.w, self.angle > NO_TURN,
+                                   np.asarray(ss, float))
 
     def position(self, s: float) -> np.ndarray:
         return self.positions(np.array([s]))[0]
@@ -337,6 +327,11 @@ class ArcPath(LinePath):
         ss = np.asarray(ss, float)
         return self.center + compiled.rotate_rows(self.normal[None], ss * self.sweep,
                                                   self._r0[None])
+
+    def poses(self, ss: np.ndarray) -> np.ndarray:
+        ss = np.asarray(ss, float)
+        return compiled.geodesic_poses(self.R0, self.w, self.angle > NO_TURN, ss,
+                                       self.positions(ss))
 
 
 def _own(path: CartesianPath) -> TypeGuard[LinePath]:
@@ -448,19 +443,19 @@ class CartesianPlanner:
         qs = ik.chain(ss, np.asarray(start_q, float))
         # refine where a joint steps too far (a fast joint near a singularity, or a branch jump)
         for _ in range(40):
-            steps = np.abs(qs[1:] - qs[:-1])
-            if steps.max() <= MAX_JOINT_STEP:
+            todo = compiled.long_steps(qs, MAX_JOINT_STEP)
+            if not len(todo):
                 break
-            todo = np.flatnonzero(steps.max(axis=1) > MAX_JOINT_STEP)
             ss, qs = _insert(ss, qs, todo, ik.between)
             if len(ss) > MAX_SAMPLES or np.min(np.diff(ss)) < 1e-7:
                 raise Unreachable("the path runs through a singularity (a joint would jump)")
         # refine where the spline strays from the path
         for _ in range(8):
             c = not_a_knot_on_unit_grid(qs) if ss is first else not_a_knot_coefficients(ss, qs)
-            mids = (ss[:-1] + ss[1:]) / 2
-            got = frames.tool_of(kin.flange_many(_pieces_at(c, mids - ss[:-1])))
-            strays = compiled.strays(poses_along(path, mids), got, STRAY_M2, STRAY_COS)
+            strays = compiled.spline_strays(
+                c, ss, poses_along(path, (ss[:-1] + ss[1:]) / 2), frames.base_inverse,
+                frames.tool, kin.shoulder, kin.upper_arm, kin.forearm, kin.hand, STRAY_M2,
+                STRAY_COS)
             if not strays.any():
                 return SplineJointPath(ss, qs, c)
             ss, qs = _insert(ss, qs, np.flatnonzero(strays), ik.between)
