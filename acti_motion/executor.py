@@ -97,7 +97,6 @@ class Device:
         self.queued_end = hold
         self._accept = threading.Lock()
         self.lock = threading.Lock()
-        self.changed = threading.Condition(self.lock)
         self.queue: deque[QueuedMotion] = deque()
         self.current: QueuedMotion | None = None
         self.t = 0.0
@@ -193,10 +192,15 @@ class Device:
     def _submit_all(self, plans: Sequence[tuple[Callable[[Any], Motion], str]]
                     ) -> tuple[list[int], str | None] | None:
         """`submit_all`'s ids with why the last is doomed (`doomed`), read in the same hold."""
-        arrived = self.arrival()
-        with self._accept:
+        arrived = None          # nobody else plans: it arrives in the hold that reads the queue
+        if not self._accept.acquire(blocking=False):
+            arrived = self.arrival()                # it arrives now, before it waits its turn
+            self._accept.acquire()
+        try:
             while True:
                 with self.lock:
+                    if arrived is None:
+                        arrived = self._stops - (self._stop_at is not None)     # `arrival`
                     if len(self.queue) + len(plans) > self.capacity:
                         return None
                     generation, start = self.generation, self.queued_end
@@ -214,6 +218,7 @@ class Device:
                         if self._stop_at is None:
                             continue        # a halt's own motion runs: plan again from its end
                     ids = []
+                    was_idle = self.current is None and not self.queue
                     for motion, (_, label) in zip(motions, plans):
                         self.last_id += 1
                         if motion.duration <= 0.0 and self.idle and not self.paused:
@@ -224,12 +229,14 @@ class Device:
                     self.revision += 1
                     if self._stop_at is None:
                         self.queued_end = self._end_of_queue()
-                    self.changed.notify_all()
-                    if self.queue:
-                        # work for the loop; a motion over at once is none: an idle loop woken
-                        # for it stepped the steps it slept over while the answer went out
+                    if was_idle and self.queue:
+                        # work for a loop that may sleep (a busy device's loop steps on); a
+                        # motion over at once is none: an idle loop woken for it stepped the
+                        # steps it slept over while the answer went out
                         self.wake()
                     return ids, self._doomed(ids[-1]) if ids else None
+        finally:
+            self._accept.release()
 
     def arrival(self) -> int:
         """A mark of now for `stopped_since`: a stop that decelerates now counts as one to come
@@ -310,7 +317,6 @@ class Device:
             out = fn(self)
             self.revision += 1
             self.queued_end = self._end_of_queue()
-            self.changed.notify_all()
             self.wake()
             return out
 
@@ -339,7 +345,6 @@ class Device:
                     continue
                 self.revision += 1
                 self.queued_end = self._end_of_queue()
-                self.changed.notify_all()
                 self.wake()
                 return out
         return STALE
@@ -369,7 +374,6 @@ class Device:
                 self.revision += 1
                 self.queue.append(QueuedMotion(self.last_id, *then))
                 self.queued_end = self._end_of_queue()
-            self.changed.notify_all()
             self.wake()
 
     @contextlib.contextmanager
@@ -396,7 +400,6 @@ class Device:
         self.last_id += 1
         entry.id = self.last_id
         self.revision += 1
-        self.changed.notify_all()
         self._announce_retired()
         return entry.id
 
@@ -451,7 +454,6 @@ class Device:
                 self.current = self.queue.popleft()
                 self.revision += 1
                 self.t = 0.0
-                self.changed.notify_all()
             t0 = self.t
             try:
                 self._advance(world, dt)
@@ -547,7 +549,6 @@ class Device:
         if not self.queue:          # where it rests, as measured (a brake's end was a forecast)
             self.queued_end = self.hold
         self.revision += 1
-        self.changed.notify_all()
         self._announce_retired()
 
     def _end_of_queue(self) -> Any:
@@ -567,7 +568,6 @@ class Device:
         self.hold = self.queued_end = motion.at(motion.duration)
         self.completed += 1
         self.retired_id = max(self.retired_id, self.last_id)
-        self.changed.notify_all()
         self._announce_retired()
 
     def _accept_discarded(self) -> int:
@@ -576,7 +576,6 @@ class Device:
         self.discarded += 1
         self._discards.add(self.last_id, self.last_id, self._reason)
         self.retired_id = max(self.retired_id, self.last_id)
-        self.changed.notify_all()
         return self.last_id
 
     def _discard_pending(self) -> None:
@@ -591,7 +590,6 @@ class Device:
             self._discards.add(self.queue[0].id, self.queue[-1].id, self._reason)
             self.retired_id = max(self.retired_id, self.queue[-1].id)
             self.queue.clear()
-            self.changed.notify_all()
             self._announce_retired()
 
     def _announce_retired(self) -> None:

@@ -20,17 +20,24 @@ def run_until(executor: MotionExecutor, predicate, max_seconds: float) -> float:
 
 
 class Announced:
-    """A lock that says (`waits`) when a thread comes to take it."""
+    """A lock that says (`waits`) when a thread comes to wait for it (a try is no wait)."""
 
     def __init__(self, lock) -> None:
         self.lock, self.waits = lock, threading.Event()
 
+    def acquire(self, blocking: bool = True) -> bool:
+        if blocking:
+            self.waits.set()
+        return self.lock.acquire(blocking)
+
+    def release(self) -> None:
+        self.lock.release()
+
     def __enter__(self):
-        self.waits.set()
-        return self.lock.__enter__()
+        return self.acquire()
 
     def __exit__(self, *exc):
-        return self.lock.__exit__(*exc)
+        self.release()
 
 
 @pytest.fixture

@@ -114,6 +114,8 @@ class ArmCore(SoftLimitWatch, MovePlanning):
         self._batch = threading.local()               # the moves an `all_or_nothing` collects
         self._cartesian_memo: tuple | None = None     # (joints sample, frames, its pose)
         self._posture_memo = None                     # a PTP plan's last posture: `_position_at`
+        self._joints_memo = None                      # a set-point's joints as floats
+        self._speeds_memo = None                      # the joints' speeds at a ratio
         executor.after_step(self._sample)
 
     def _apply_settings(self, c: ArmConfig) -> None:
@@ -418,9 +420,9 @@ class ArmCore(SoftLimitWatch, MovePlanning):
         self._check_can_move(self.speed_joint, "set_speed_joint")
         step = finite_floats(joint_points, self.axis_count, "joint_points")
         self._check_joint_step(step, "joint_points")
-        delta = [math.radians(d) for d in step]
+        delta = list(map(math.radians, step))
         return self.queue_joint_move(
-            lambda start: [a + d for a, d in zip(start.joints.tolist(), delta)],
+            lambda start: [a + d for a, d in zip(self.joint_floats(start.joints), delta)],
             "move_ptp_joint_rel")
 
     @returns(*MOVE)

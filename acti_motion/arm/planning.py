@@ -117,6 +117,8 @@ class MovePlanning:
     _limit_rows: Callable[[], np.ndarray]
     _for_limits: Callable[..., Any]
     _posture_memo: tuple[Frames, list[float], list[float]] | None   # (frames, joints, position)
+    _joints_memo: tuple[np.ndarray, list[float]] | None             # (set-point joints, floats)
+    _speeds_memo: tuple[np.ndarray, float, list[float]] | None      # (rated, ratio, speeds)
 
     # === checks ======================================================================================
     def _limit_floats(self) -> tuple[list[list[float]], list[list[float]], list[list[float]]]:
@@ -234,17 +236,18 @@ class MovePlanning:
         """A PTP move to goal_of(start) (rad): synchronized trapezoid at the joint speed ratio
         and accel time (or the given ones: STROLIC programs keep their own). The 7 joints'
         arithmetic is in plain floats (numpy's calls cost 1 … 3 µs each on a cold core)."""
-        ratio = self.speed_joint if speed_ratio is None else speed_ratio
-        speed = [math.radians(v) * ratio / 100.0 for v in self.max_speed_joint.tolist()]
+        speed = self._joint_speeds(self.speed_joint if speed_ratio is None else speed_ratio)
         ramp = self.accel_time_joint if ramp is None else ramp
 
         def plan(start: ArmSetpoint) -> ArmMotion:
             frames = self.frames          # read while planning: the offsets wait for it
             goal = floats(goal_of(start))
-            self._check_joint_target([math.degrees(g) for g in goal], label)
-            q0 = start.joints.tolist()
+            self._check_joint_target(list(map(math.degrees, goal)), label)
+            q0 = self.joint_floats(start.joints)
             delta = [g - a for g, a in zip(goal, q0)]
-            path = LinearJointPath(start.joints, np.array(goal))
+            end = [a + d for a, d in zip(q0, delta)]
+            path = LinearJointPath.from_floats(start.joints, delta, end)
+            self._joints_memo = (path.end, end)     # where the next move starts
             steps = 1 + max(1, math.ceil(math.degrees(max(map(abs, delta)))))
 
             def position_at(q: list[float]) -> list[float]:
@@ -262,6 +265,28 @@ class MovePlanning:
             timing = Trapezoid.for_axes(delta, speed, ramp)
             return ArmMotion(path, timing, start.finger, start.finger, ramp, "joint")
         return self._submit(plan, label)
+
+    def _joint_speeds(self, ratio: float) -> list[float]:
+        """The joints' speeds (rad/s) at `ratio` %, made again only when the ratio or the rated
+        speeds changed (each setter assigns a new array; a numpy call on every accept)."""
+        memo = self._speeds_memo
+        if memo is None or memo[0] is not self.max_speed_joint or memo[1] != ratio:
+            rated = self.max_speed_joint
+            memo = self._speeds_memo = (rated, ratio, [math.radians(v) * ratio / 100.0
+                                                       for v in rated.tolist()])
+        return memo[2]
+
+    def joint_floats(self, joints: np.ndarray) -> list[float]:
+        """joints.tolist(), kept for the last array asked or planned to (a PTP plan keeps its
+        end's, where the next move starts): a move's goal and its line read the start's floats,
+        which took a numpy call each on the cold core of an accept. Set-points are never
+        changed in place."""
+        memo = self._joints_memo
+        if memo is not None and memo[0] is joints:
+            return memo[1]
+        values = joints.tolist()
+        self._joints_memo = (joints, values)
+        return values
 
     def _position_at(self, frames: Frames, q: list[float]) -> list[float]:
         """The control point (mm) of posture q (rad) in `frames`; the last one computed is kept:

@@ -78,8 +78,20 @@ class LinearJointPath:
     def __init__(self, q0: np.ndarray, q1: np.ndarray) -> None:
         self.q0 = np.asarray(q0, float)
         self.delta = np.asarray(q1, float) - self.q0
+        self.end: np.ndarray | None = None      # q(1.0), when made in advance (`from_floats`)
+
+    @classmethod
+    def from_floats(cls, q0: np.ndarray, delta: list[float], end: list[float]) -> "LinearJointPath":
+        """The line from q0 (an array) by `delta`, ending at `end` = q0 + delta in floats (the
+        very values numpy's q(1.0) gives): two numpy calls where the constructor and q(1.0)
+        take six, 1 … 3 µs each on the cold core of a PTP accept."""
+        path = cls.__new__(cls)
+        path.q0, path.delta, path.end = q0, np.array(delta), np.array(end)
+        return path
 
     def q(self, s: float) -> np.ndarray:
+        if s == 1.0 and self.end is not None:
+            return self.end
         return self.q0 + s * self.delta
 
     def dq(self, s: float) -> np.ndarray:
