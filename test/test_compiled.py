@@ -293,7 +293,7 @@ def test_the_kernels_load_from_the_cache_and_never_compile_again():
             "sum(k.stats.cache_misses.__len__() for k in ks), time.process_time() - t)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout.split()
-    assert int(out[0]) == 17 and out[1] == "True" and out[2] == "0", out
+    assert int(out[0]) == 18 and out[1] == "True" and out[2] == "0", out
     with pytest.raises(TypeError):
         compiled.line_positions(np.zeros(3, dtype=np.float32), np.zeros(3), np.zeros(2))
 
@@ -336,3 +336,15 @@ def test_the_spline_s_middles_and_steps_are_the_numpy_formula_s(kin):
                               compiled.geodesic_poses(R0, w, True, ss,
                                                       compiled.line_positions(p0, dp, ss)))
     assert seen == {False, True}
+
+
+def test_the_rel_rule_s_kernel_is_the_numpy_formula():
+    rng = np.random.default_rng(13)
+    for _ in range(60):
+        start, delta = np.eye(4), np.eye(4)
+        start[:3, :3], start[:3, 3] = pin.exp3(rng.normal(0, 2, 3)), rng.normal(0, 1, 3)
+        delta[:3, :3], delta[:3, 3] = pin.exp3(rng.normal(0, 2, 3)), rng.normal(0, 1, 3)
+        got = compiled.relative_pose(start, delta)
+        assert np.max(np.abs(got[:3, :3] - delta[:3, :3] @ start[:3, :3])) < 1e-15
+        assert np.array_equal(got[:3, 3], start[:3, 3] + delta[:3, 3])
+        assert np.array_equal(got[3], [0.0, 0.0, 0.0, 1.0])

@@ -79,6 +79,17 @@ def rotate_rows(axes: np.ndarray, angles: np.ndarray, v: np.ndarray) -> np.ndarr
     return out
 
 
+# --- poses ---------------------------------------------------------------------------------------
+@_kernel(float64[:, ::1](_A2, _A2))
+def relative_pose(start: np.ndarray, delta: np.ndarray) -> np.ndarray:
+    """The Cartesian Rel rule: the pose with R = ΔR·R₀ and p = p₀ + Δp (4×4 each)."""
+    out = np.eye(4)
+    out[:3, :3] = _mat3(delta[:3, :3], start[:3, :3])
+    for r in range(3):
+        out[r, 3] = start[r, 3] + delta[r, 3]
+    return out
+
+
 # --- forward kinematics ---------------------------------------------------------------------------
 @_kernel(float64[:, :, ::1](_A2, _A1, float64, float64, float64))
 def flange_poses(qs: np.ndarray, shoulder: np.ndarray, upper_arm: float, forearm: float,

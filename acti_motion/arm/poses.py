@@ -12,6 +12,7 @@ from typing import Iterable
 import numpy as np
 import pinocchio as pin
 
+from acti_motion.arm import compiled
 from acti_motion.replies import Refused, ReturnCode, finite_vector
 
 ROTATION_TOLERANCE = 1e-3
@@ -91,10 +92,7 @@ def rotation_angle(R0: np.ndarray, R1: np.ndarray) -> float:
 
 def compose_relative(start: np.ndarray, delta: np.ndarray) -> np.ndarray:
     """The Cartesian Rel rule, in the robot frame: p' = p + Δp, R' = ΔR·R."""
-    out = np.eye(4)
-    out[:3, :3] = delta[:3, :3] @ start[:3, :3]
-    out[:3, 3] = start[:3, 3] + delta[:3, 3]
-    return out
+    return compiled.relative_pose(start, delta)
 
 
 def position_error_mm(A: np.ndarray, B: np.ndarray) -> float:
