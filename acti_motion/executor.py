@@ -291,6 +291,11 @@ class Device:
             cur = self.current
             if cur is None:
                 self.rate = self._rate_target = 1.0
+            elif self.rate <= 0.0:
+                # at rest (a pause held it): nothing decelerates, so the stop is over now. Left
+                # to the next step, a move accepted before it was discarded as if it had come
+                # during a deceleration, which a busy machine made tens of ms long.
+                self._finish(discarded=True)
             else:
                 if self._stop_at is None:
                     # a move cut short to hand over to the next (a blend) stops along its whole path

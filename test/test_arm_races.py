@@ -417,6 +417,25 @@ def test_a_paused_arm_at_rest_is_not_moving_right_after_stop_or_servo_off(arm, e
     assert arm.state_word() == (SERVO if halt == "stop" else 0) and not arm.device.busy
 
 
+@pytest.mark.parametrize("halt", ["stop", "servo_off"])
+def test_a_move_sent_right_after_a_halt_at_rest_runs(arm, executor, trace, halt):  # noqa: F811
+    """A paused arm at rest has nothing to decelerate, so its stop is over at once: a move
+    accepted before the next control step was discarded as if it had come during a
+    deceleration ("discarded: stop", over DDS at load 10)."""
+    assert arm.move_ptp_joint_rel([20.0] * 7).ok
+    steps(executor, 60)
+    assert arm.pause().ok
+    run_until(executor, lambda: arm.state_word() == SERVO | PAUSED, 2.0)
+    assert getattr(arm, halt)().ok
+    arm.servo_on()
+    r = arm.move_ptp_joint_rel([4.0] * 7)          # before the simulation steps again
+    assert r.ok and not r.comment                  # not "discarded: stop"
+    moved = r.values["motion_id"]
+    rest(executor, arm)
+    assert arm.device.completed == 1 and not arm.device.was_discarded(moved)
+    trace.check()
+
+
 def test_the_moving_bit_lasts_while_the_measured_joints_move(arm, executor):  # noqa: F811
     """After a stop the set-point rests, and the joints follow it for a few control periods
     more: the word said not moving (and, after servo_off, 0x00) while they still moved."""
