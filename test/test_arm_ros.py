@@ -115,7 +115,10 @@ def test_bad_inputs_answer_the_right_id_and_the_node_stays_up(ros, arm_node, nam
 
 
 def test_service_move_then_wait_motion_with_feedback(ros, arm_node, wait_motion):
+    """At 20 % the line takes seconds of simulated time, many feedback periods (at 80 % it
+    could end before a busy machine delivered the goal and the first feedback tick)."""
     ready(ros)
+    assert call(ros, "set_speed_cartesian", srv.SetSpeedCartesian, spd_ratio=20).return_id.id == 0
     start = call(ros, "get_feedback_pos_cartesian", srv.GetFeedbackPosCartesian).pos.car_pos
     r = call(ros, "move_linear_cartesian_rel", srv.MoveLinearCartesianRel,
              car_point=rel(dx=100.0, dz=-150.0))
@@ -126,7 +129,8 @@ def test_service_move_then_wait_motion_with_feedback(ros, arm_node, wait_motion)
     assert status == GoalStatus.STATUS_SUCCEEDED and result.completed
     assert result.motion_id == r.motion_id
     assert feedback and feedback[-1].current_label == "move_linear_cartesian_rel"
-    time.sleep(0.1)
+    # the set-point is at the end; the joints settle onto it (moving until then)
+    assert wait_until(lambda: not call(ros, "get_state", srv.GetState).state & 0x02, 10.0)
     end = call(ros, "get_feedback_pos_cartesian", srv.GetFeedbackPosCartesian).pos.car_pos
     assert end[3] - start[3] == pytest.approx(100.0, abs=0.1)
     assert end[11] - start[11] == pytest.approx(-150.0, abs=0.1)
@@ -227,9 +231,14 @@ def test_stop_or_servo_off_of_a_paused_arm_at_rest_answers_not_moving_at_once(ro
     halt_type = {"stop": srv.Stop, "servo_off": srv.ServoOFF}[halt]
     for _ in range(5):
         ready(ros)
+        # slow, so that it is still under way when the pause comes, however busy the machine
+        call(ros, "set_speed_joint", srv.SetSpeedJoint, spd_ratio=10)
         assert call(ros, "move_ptp_joint_rel", srv.MovePTPJointRel,
                     joint_points=[4.0] * 7).return_id.id == 0
-        assert call(ros, "pause", srv.Pause).return_id.id == 0
+        paused = call(ros, "pause", srv.Pause).return_id
+        # held, not ignored: the halt before, at rest, was over at once and discarded nothing
+        # sent after it (the move was "discarded: stop" when no control step came between)
+        assert paused.id == 0 and not paused.comment, paused.comment
         assert wait_until(lambda: call(ros, "get_state", srv.GetState).state == 0x11, 30.0), \
             call(ros, "get_state", srv.GetState).state
         assert call(ros, halt, halt_type).return_id.id == 0
