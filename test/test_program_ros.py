@@ -13,16 +13,21 @@ from acti_msgs import srv
 from acti_msgs.action import RunProgram
 from acti_msgs.msg import ArmState
 from action_msgs.msg import GoalStatus
+from rosgraph_msgs.msg import Clock
+from service_msgs.msg import ServiceEventInfo
 
+from acti_record.timing import ClockMap
 from ros_harness import Actions, node_fixture, wait_until
 from test_arm_ros import ARM, call
 from strolic.text import assemble
 
-arm_node = node_fixture("acti_middle_node")
+arm_node = node_fixture("acti_middle_node", "state_rate_hz:=100.0")   # 40 ms simulated
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples" / "strolic"
 READY_MM = (663.5, 0.0, 463.3)    # the control point of the examples' ready posture
 ACCEL_TIME = 0.3                  # the arm's accel/decel time (config/acti_ros2.yaml)
+CONTROL_PERIOD_S = 1 / 250.0      # the job's default rate_hz
+SETTLE_S = 0.05                   # the measured joints follow a stopped set-point 21-38 ms more
 R = RunProgram.Result
 
 
@@ -33,12 +38,38 @@ def programs(ros, arm_node):
 
 @pytest.fixture(scope="module")
 def states(ros, arm_node):
-    """(stamp [s, simulated], state word) of every ~/state message from here on."""
+    """(stamp [s, simulated], state word) of every ~/state message from here on (all of them:
+    with the latest only, a busy test process missed the first at rest)."""
     seen = []
-    ros.node.create_subscription(      # depth 1: the latest message whenever the test spins
+    ros.node.create_subscription(
         ArmState, ARM + "state",
-        lambda m: seen.append((m.stamp.sec + 1e-9 * m.stamp.nanosec, m.state)), 1)
+        lambda m: seen.append((m.stamp.sec + 1e-9 * m.stamp.nanosec, m.state)), 1000)
     return seen
+
+
+@pytest.fixture(scope="module")
+def job_clock(ros, arm_node):
+    """The job's simulated time at moments of its wall clock (its /clock messages)."""
+    clock = ClockMap()
+    ros.node.create_subscription(
+        Clock, "/clock",
+        lambda m, info: clock.add(info["source_timestamp"], m.clock.sec * 10**9 + m.clock.nanosec),
+        1000)
+    return clock
+
+
+@pytest.fixture(scope="module")
+def cancels_answered(ros, arm_node):
+    """When the job answered each cancel of ~/run_program [ns, its wall clock]: its service
+    event (service introspection, on by default)."""
+    answered = []
+    event = RunProgram.Impl.CancelGoalService.Event
+    events = ros.node.create_subscription(
+        event, ARM + "run_program/_action/cancel_goal/_service_event",
+        lambda e: answered.append(e.info.stamp.sec * 10**9 + e.info.stamp.nanosec)
+        if e.info.event_type == ServiceEventInfo.RESPONSE_SENT else None, 100)
+    assert ros.spin_until(lambda: events.get_publisher_count() > 0, 30.0)
+    return answered
 
 
 def ready(ros):
@@ -82,7 +113,12 @@ def test_examples_run_through_the_action_and_end_where_they_should(ros, programs
     assert math.dist((pos[3], pos[7], pos[11]), READY_MM) < 1.0
 
 
-def test_cancel_mid_motion_stops_the_arm_within_its_deceleration_time(ros, programs, states):
+def test_cancel_mid_motion_stops_the_arm_within_its_deceleration_time(ros, programs, states,
+                                                                      job_clock, cancels_answered):
+    """Timed on the job's own clock: from its answer to the cancel (the stop is in force then)
+    to the last ~/state message that says moving. The test's wall clock added its own
+    scheduling, four times over at the job's real_time_factor of 4 (and a ~/state subscription
+    that kept only the latest message missed the first at rest)."""
     ready(ros)
     feedback = []
     handle = programs.send(lambda f: feedback.append(f.feedback),
@@ -90,18 +126,22 @@ def test_cancel_mid_motion_stops_the_arm_within_its_deceleration_time(ros, progr
     assert ros.spin_until(lambda: any(f.motion_label == "IDRIVE" and f.progress > 0.2
                                        for f in feedback) and states and states[-1][1] & 0x02,
                       30.0)
-    sent_at = states[-1][0]
+    answered = len(cancels_answered)
     programs.spin(handle.cancel_goal_async())
     status, result = programs.result(handle)
     assert status == GoalStatus.STATUS_CANCELED and result.status == R.CANCELED
     assert result.exception_kind == "stopped by the operator" and result.stack == ["-1"]
     # answered once the arm is at rest: a program sent now is not discarded by that stop
     assert not call(ros, "get_state", srv.GetState).state & 0x02
-    assert ros.spin_until(lambda: any(t > sent_at and not word & 0x02 for t, word in states),
-                      10.0)
-    rest_at = next(t for t, word in states if t > sent_at and not word & 0x02)
-    # the state topic's period (0.2 s simulated) on either side of the deceleration
-    assert rest_at - sent_at < ACCEL_TIME + 0.5
+    assert ros.spin_until(lambda: len(cancels_answered) > answered, 10.0)
+    stopped_at = job_clock.sim_at(cancels_answered[answered]) * 1e-9
+    assert ros.spin_until(lambda: any(t > stopped_at and not word & 0x02 for t, word in states),
+                          10.0)
+    last_moving = max(t for t, word in states if word & 0x02)
+    # the deceleration, one control period, the joints' settling onto the set-point at rest
+    # (the word says moving meanwhile) and the clock map's resolution (a /clock period)
+    allowed = ACCEL_TIME + CONTROL_PERIOD_S + SETTLE_S + job_clock.period_ns() * 1e-9
+    assert last_moving - stopped_at <= allowed, (last_moving - stopped_at, allowed)
     pos = call(ros, "get_feedback_pos_joint", srv.GetFeedbackPosJoint).pos
     assert pos[6] > -140.0                                  # it did not go on to the end
 

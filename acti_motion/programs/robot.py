@@ -42,6 +42,8 @@ from strolic.host import Host, MemoryIO
 from strolic.process import WAIT, Process, State
 from strolic.values import array_elements
 
+CANCELED = "the run was canceled"          # what a canceled run's exception says
+
 if TYPE_CHECKING:
     from strolic.opcodes import Opcode
     from strolic.vm import VM
@@ -256,7 +258,7 @@ class RobotHost(Host):
 
     def check(self, vm: VM) -> None:
         if self.cancel_event.is_set():
-            raise fail(K.STOPPED, "the run was canceled")
+            raise fail(K.STOPPED, CANCELED)
         now = self.now()
         if self._interrupted(vm):
             self._frozen += now - self._last_check

@@ -14,10 +14,10 @@ from dataclasses import dataclass, field
 
 from acti_motion.arm.core import ArmCore
 from acti_motion.programs.debugger import Debugger, LineVM
-from acti_motion.programs.robot import ProgramDefaults, RobotHost
+from acti_motion.programs.robot import CANCELED, ProgramDefaults, RobotHost
 from roboline import Program
 from strolic.codec import decode
-from strolic.errors import ExceptionKind as K, StrolicError
+from strolic.errors import ExceptionKind as K, StrolicError, fail
 from strolic.host import MemoryIO
 from strolic.literals import format_value
 from strolic.process import State
@@ -214,8 +214,14 @@ class ProgramRun:
         return self.result is not None
 
     def cancel(self) -> None:
-        """Stop the program and the arm (it decelerates); the run ends with CANCELED."""
-        self.host.cancel_event.set()
+        """Stop the program and the arm; the run ends with CANCELED. The arm starts to
+        decelerate here, on the canceling thread: a cancel is a stop, and the program's thread,
+        which stopped it before, ran only when the machine let it (the arm then ran on for up
+        to a few control periods more under load)."""
+        host = self.host
+        host.cancel_event.set()
+        if self.result is None and host.state != "stopping":
+            host.stop(fail(K.STOPPED, CANCELED))
 
     def progress(self) -> Progress:
         vm, host = self.vm, self.host
