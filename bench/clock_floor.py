@@ -3,7 +3,9 @@ rosgraph_msgs/Clock on /bare_clock every period, scheduled as the job's control 
 bench (niceness -10, SCHED_FIFO 10) and sharing nothing with the job. Its largest silence in a
 case is what the machine itself allowed then:
 
-    python -m bench.clock_floor [period_s]     (default 0.004: the job's 250 Hz)
+    python -m bench.clock_floor [period_s [fifo_priority]]   (defaults 0.004: the job's 250 Hz;
+                                                             10; 0: ordinary scheduling, as the
+                                                             job's loop by default)
 """
 import sys
 import time
@@ -22,11 +24,12 @@ NICENESS = -10               # the job's
 def main() -> None:
     args = rclpy.utilities.remove_ros_args(sys.argv)
     period = float(args[1]) if len(args) > 1 else 0.004
+    fifo = int(args[2]) if len(args) > 2 else FIFO_PRIORITY
     init(sys.argv)
     node = rclpy.create_node("bare_clock")
     publisher = node.create_publisher(Clock, TOPIC, 10)
     set_niceness(NICENESS, print)
-    set_fifo(FIFO_PRIORITY, print)
+    set_fifo(fifo, print)
     due = time.monotonic()
     try:
         while not stop_requested():

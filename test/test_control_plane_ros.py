@@ -12,6 +12,7 @@ import time
 from dataclasses import dataclass
 from typing import Any, Callable
 
+import numpy as np
 import pytest
 from acti_msgs import srv
 from acti_msgs.action import Move, VehicleWaitMotion, WaitMotion
@@ -19,6 +20,7 @@ from action_msgs.msg import GoalStatus
 from rosgraph_msgs.msg import Clock
 
 from acti_bringup.harness import FELL_BEHIND, OneShotClients
+from bench.clock_floor import TOPIC as BARE_CLOCK
 from ros_harness import Actions, NodeProcess, node_fixture, wait_until
 
 ARM_GOALS, BASE_GOALS = 3, 2
@@ -248,26 +250,69 @@ def test_wait_motion_refuses_a_timeout_that_is_not_finite_and_positive(ros, devi
 
 
 HELD_UP_MS = 200        # Fast DDS's sleep at a shared-memory port: 333 ms
+# a line of the job's log that says the control loop fell behind: its wall time [s], the fall [ms]
+FALL_LINE = re.compile(r"\[WARN\] \[(\d+\.\d+)\] .*" + FELL_BEHIND)
 
 
-def test_participants_that_come_and_go_never_hold_up_the_control_loop(ros, job):
+def not_the_machines(log: str, bare_sent: list[float]) -> list[int]:
+    """The falls behind in `log` [ms] that the bare clock publisher beside the job did not
+    share: the machine (a KVM guest stalled, other tests' jobs on both cores) held that process
+    silent for less than half the fall in the fall's window. A fall is reported right after it
+    (its line's time), so it lasted from the line's time less the fall until then."""
+    sent = np.array(bare_sent)
+    ours = []
+    for at, ms in FALL_LINE.findall(log):
+        end, fall = float(at), int(ms) * 1e-3
+        window = sent[(sent >= end - fall - 0.05) & (sent <= end + 0.05)]
+        silence = float(np.max(np.diff(window))) if len(window) > 1 else math.inf
+        if silence < fall / 2:
+            ours.append(int(ms))
+    return ours
+
+
+def test_participants_that_come_and_go_never_hold_up_the_control_loop(ros, job, tmp_path):
     """Fast DDS sleeps a third of a second inside a send when it meets the shared-memory port of
     a participant that is starting or ending, and rclpy sent with the GIL held: about one in
     five one-shot clients froze the whole job, the control loop with it (it publishes /clock
     while anybody listens). Sends now leave from the outbox without the GIL, and the loop
     reports any fall behind its schedule; here none is one of Fast DDS's sleeps, and the job
-    answers between the clients."""
+    answers between the clients. A bare process that publishes a Clock every 4 ms, scheduled as
+    the job's loop, tells the machine's stalls from the job's: under load (the full suite beside
+    other engineers' runs) the loop fell behind by over 200 ms when the machine held every
+    process."""
+    bare_sent: list[float] = []
+    bare = NodeProcess("bench.clock_floor", str(tmp_path / "bare.log"), args=("0.004", "0"))
+    heard = ros.node.create_subscription(
+        Clock, BARE_CLOCK, lambda _m, info: bare_sent.append(info["source_timestamp"] * 1e-9), 1000)
     clock = ros.node.create_subscription(Clock, "/clock", lambda _msg: None, 10)
-    seen = len(job.log())
-    clients = OneShotClients(srv.GetState, ARM + "get_state")
     try:
-        deadline = time.monotonic() + 15.0
-        while time.monotonic() < deadline:
-            clients.keep()
-            assert ros.call(srv.GetState, ARM + "get_state").return_id.id == 0
-            ros.spin_until(lambda: False, 0.05)
+        assert ros.spin_until(lambda: len(bare_sent) > 10, 30.0), bare.log()
+        seen = len(job.log())
+        clients = OneShotClients(srv.GetState, ARM + "get_state")
+        try:
+            deadline = time.monotonic() + 15.0
+            while time.monotonic() < deadline:
+                clients.keep()
+                assert ros.call(srv.GetState, ARM + "get_state").return_id.id == 0
+                ros.spin_until(lambda: False, 0.05)
+        finally:
+            clients.end()
+        ros.spin_until(lambda: False, 0.5)          # the bare messages of the last moments
     finally:
-        clients.end()
+        bare.stop()
         ros.node.destroy_subscription(clock)
-    falls = [int(ms) for ms in re.findall(FELL_BEHIND, job.log()[seen:])]
-    assert clients.started >= 6 and all(ms < HELD_UP_MS for ms in falls), (clients.started, falls)
+        ros.node.destroy_subscription(heard)
+    log = job.log()[seen:]
+    falls = [int(ms) for ms in re.findall(FELL_BEHIND, log)]
+    ours = not_the_machines(log, bare_sent)
+    assert clients.started >= 6 and all(ms < HELD_UP_MS for ms in ours), \
+        (clients.started, falls, ours)
+
+
+def test_a_fall_behind_is_the_machines_only_when_the_bare_publisher_fell_silent_too():
+    log = "[WARN] [100.500000000] [job]: the control loop fell 300 ms behind real time (held up)\n"
+    regular = list(np.arange(99.0, 101.0, 0.004))
+    assert not_the_machines(log, regular) == [300]
+    stalled = [t for t in regular if not 100.2 < t < 100.45]
+    assert not_the_machines(log, stalled) == []
+    assert not_the_machines(log, [t for t in regular if not 100.3 < t < 100.4]) == [300]
