@@ -293,7 +293,7 @@ def test_the_kernels_load_from_the_cache_and_never_compile_again():
             "sum(k.stats.cache_misses.__len__() for k in ks), time.process_time() - t)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout.split()
-    assert int(out[0]) == 18 and out[1] == "True" and out[2] == "0", out
+    assert int(out[0]) == 19 and out[1] == "True" and out[2] == "0", out
     with pytest.raises(TypeError):
         compiled.line_positions(np.zeros(3, dtype=np.float32), np.zeros(3), np.zeros(2))
 
@@ -348,3 +348,20 @@ def test_the_rel_rule_s_kernel_is_the_numpy_formula():
         assert np.max(np.abs(got[:3, :3] - delta[:3, :3] @ start[:3, :3])) < 1e-15
         assert np.array_equal(got[:3, 3], start[:3, 3] + delta[:3, 3])
         assert np.array_equal(got[3], [0.0, 0.0, 0.0, 1.0])
+
+
+def test_the_spline_at_a_point_is_ppoly_s_to_the_last_bit():
+    """spline_at (SplineJointPath.q) against scipy's PPoly: at the breakpoints, between them,
+    before and beyond the ends, and at NaN."""
+    from scipy.interpolate import PPoly
+
+    from acti_motion.arm.trajectories import not_a_knot_coefficients
+    rng = np.random.default_rng(1)
+    for n in (4, 5, 9, 30, 200):
+        ss = np.concatenate([[0.0], np.sort(rng.uniform(0, 1, n - 2)), [1.0]])
+        c = not_a_knot_coefficients(ss, np.cumsum(rng.normal(size=(n, 7)), axis=0))
+        spline = PPoly.construct_fast(c, ss)
+        points = [*ss, *rng.uniform(-0.1, 1.1, 200), np.nextafter(1.0, 0.0),
+                  np.nextafter(1.0, 2.0), -0.0, math.nan]
+        for s in points:
+            assert np.array_equal(compiled.spline_at(c, ss, s), spline(s), equal_nan=True)

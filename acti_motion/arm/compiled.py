@@ -380,6 +380,38 @@ def spline_middles(c: np.ndarray, ss: np.ndarray) -> np.ndarray:
     return out
 
 
+@_kernel(float64[::1](_A3, _A1, float64))
+def spline_at(c: np.ndarray, ss: np.ndarray, s: float) -> np.ndarray:
+    """The cubic spline (coefficients c, breakpoints ss) at s, as scipy's PPoly evaluates it
+    (the same floats): the piece with ss[i] <= s < ss[i + 1] (the last one at its end and
+    beyond, the first before it), its power series summed from the constant term up."""
+    n = len(ss)
+    if s >= ss[n - 1]:
+        i = n - 2
+    elif s < ss[0]:
+        i = 0
+    else:
+        lo, hi = 0, n - 2
+        while lo < hi:
+            mid = (lo + hi + 1) // 2
+            if s >= ss[mid]:
+                lo = mid
+            else:
+                hi = mid - 1
+        i = lo
+    x = s - ss[i]
+    out = np.empty(c.shape[2])
+    for j in range(c.shape[2]):
+        total, z = 0.0, 1.0
+        for k in range(c.shape[0]):
+            total = total + c[c.shape[0] - k - 1, i, j] * z
+            z *= x
+        out[j] = total
+    if s != s:                            # NaN: PPoly's answer
+        out[:] = np.nan
+    return out
+
+
 @_kernel(boolean[::1](_A3, _A1, _A3, _A2, _A2, _A1, float64, float64, float64, float64,
                       float64))
 def spline_strays(c: np.ndarray, ss: np.ndarray, want: np.ndarray, to_robot: np.ndarray,

@@ -199,7 +199,9 @@ class SplineJointPath:
         return self._d2
 
     def q(self, s: float) -> np.ndarray:
-        return self.spline(s)
+        """q(s): PPoly's floats, in one compiled call (the run asks every control period, an
+        accept for the end)."""
+        return compiled.spline_at(self.c, self.ss, s)
 
     def dq(self, s: float) -> np.ndarray:
         return self.d1(s)
