@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import operator
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,7 +31,10 @@ class Trapezoid:
             v = v * len(d)
         if not any(d):
             return cls(0.0, 0.0)
-        cruise = max(abs(a) / b if b else (math.inf if a else 0.0) for a, b in zip(d, v))
+        if all(v):                  # the usual case, without a Python step per axis
+            cruise = max(map(operator.truediv, map(abs, d), v))
+        else:
+            cruise = max(abs(a) / b if b else (math.inf if a else 0.0) for a, b in zip(d, v))
         return cls(max(cruise, ramp) + ramp, ramp)
 
     @property

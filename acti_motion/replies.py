@@ -58,21 +58,27 @@ def plans(fn: Callable[..., Any]) -> Callable[..., Any]:
     return fn
 
 
-def answers(fn: Callable[..., dict[str, Any] | Reply | None]) -> Callable[..., Reply]:
+def answers(fn: Callable[..., dict[str, Any] | Reply | None],
+            allowed: frozenset[ReturnCode] | None = None) -> Callable[..., Reply]:
     """Wrap a core operation: its out-values dict becomes an OK reply, `Refused` a refusal, and
     any other exception (a bug, or input no check foresaw) NG with a comment that says what
-    failed: a request never ends the process and never leaves a traceback in the log."""
+    failed: a request never ends the process and never leaves a traceback in the log. Given
+    `allowed` (`returns`), a refusal with another id becomes NG, comment kept."""
     @functools.wraps(fn)
     def wrapper(*args: Any, **kwargs: Any) -> Reply:
         try:
             out = fn(*args, **kwargs)
         except Refused as r:
+            if allowed is not None and r.code not in allowed:
+                return Reply(ReturnCode.NG, r.comment)
             return Reply(r.code, r.comment)
         except Exception as e:
             comment = f"{fn.__name__} failed: {type(e).__name__}: {e}"
             _log.error(comment)
             return Reply(ReturnCode.NG, comment)
         if isinstance(out, Reply):
+            if allowed is not None and out.code not in allowed:
+                return Reply(ReturnCode.NG, out.comment, out.values)
             return out
         return Reply(values=out or {})
     return wrapper
@@ -81,18 +87,12 @@ def answers(fn: Callable[..., dict[str, Any] | Reply | None]) -> Callable[..., R
 def returns(*codes: ReturnCode) -> Callable[[Callable[..., Any]], Callable[..., Reply]]:
     """`answers`, for an operation whose spec lists exactly OK, NG and `codes`: a refusal with
     any other id becomes NG ("failed for another reason"), comment kept. The allowed ids are
-    the wrapper's `return_codes`, for tests and documentation."""
+    the wrapper's `return_codes`, for tests and documentation. One wrapper, not two: every
+    call of an operation (a move's accept, a getter) goes through it."""
     allowed = frozenset((ReturnCode.OK, ReturnCode.NG, *codes))
 
     def decorate(fn: Callable[..., Any]) -> Callable[..., Reply]:
-        inner = answers(fn)
-
-        @functools.wraps(fn)
-        def wrapper(*args: Any, **kwargs: Any) -> Reply:
-            reply = inner(*args, **kwargs)
-            if reply.code not in allowed:
-                return Reply(ReturnCode.NG, reply.comment, reply.values)
-            return reply
+        wrapper = answers(fn, allowed)
         wrapper.return_codes = allowed  # type: ignore[attr-defined]
         return wrapper
     return decorate
@@ -108,10 +108,13 @@ def floats(values: np.ndarray | list[float]) -> list[float]:
     return values if isinstance(values, list) else np.asarray(values, float).reshape(-1).tolist()
 
 
+_ONLY_FLOATS = {float}
+
+
 def finite_floats(values: Iterable[float], length: int | tuple[int, ...], name: str) -> list[float]:
     """`values` as a list of floats of an allowed length, all finite, else VALUE_ERR. A list of
     floats (what a ROS request's array is read as) is checked as it is, without numpy."""
-    if type(values) is list and all(type(x) is float for x in values):
+    if type(values) is list and {*map(type, values)} == _ONLY_FLOATS:
         got = list(values)
     else:
         got = np.asarray(values if isinstance(values, list) else list(values),

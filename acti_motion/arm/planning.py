@@ -12,6 +12,7 @@ A part of `ArmCore` (mixed in; uses its attributes).
 from __future__ import annotations
 
 import math
+import operator
 import threading
 from contextlib import contextmanager
 from typing import Any, Callable, Iterator
@@ -62,10 +63,11 @@ def _well_inside(values: np.ndarray | list[list[float]], bounds: np.ndarray | li
     samples cost ~25 µs of its accept; a longer path goes to numpy (False)."""
     if len(values) > FEW_POSTURES:
         return False
-    box = [(lo + margin, hi - margin)
-           for lo, hi in (bounds.tolist() if isinstance(bounds, np.ndarray) else bounds)]
+    lower, upper = zip(*(bounds.tolist() if isinstance(bounds, np.ndarray) else bounds))
+    lower, upper = [lo + margin for lo in lower], [hi - margin for hi in upper]
     rows = values.tolist() if isinstance(values, np.ndarray) else values
-    return all(lo < v < hi for row in rows for v, (lo, hi) in zip(row, box))
+    return all(all(map(operator.lt, lower, row)) and all(map(operator.lt, row, upper))
+               for row in rows)
 
 
 def _position_mm(pose: np.ndarray) -> list[float]:
