@@ -109,12 +109,63 @@ def test_the_queued_ptp_motion_is_the_numpy_formula_s(arm, step):  # noqa: F811
 
 
 def test_the_kept_posture_is_the_next_move_s_start_and_gives_the_same_position(arm):  # noqa: F811
-    """A PTP move's last posture is kept (`_position_at`); the next move starts at its end
-    (`path.q(1.0)`, the same floats) and finds it there: its position is what Pinocchio gives."""
+    """A PTP plan that computes its line's postures keeps the last one (`_position_at`): its
+    end, where the next move starts (`path.q(1.0)`, the same floats); its position is what
+    Pinocchio gives. A move near the kept posture, well inside the box, computes none."""
     kin, frames = shared_kinematics(), arm.frames
-    for step in ([0.5] * 7, [-0.5] * 7, [3.0, -2.0, 1.0, 0.0, 0.5, -0.25, 7.0]):
+    x, y, z = _line_positions_mm(kin, frames, arm.device.queued_end.joints.tolist(),
+                                 [0.0] * 7, [0.0])[0]
+    assert arm.set_soft_limit_box((x - 150, x + 150, y - 150, y + 150, z - 150, z + 150)).ok
+    frames = arm.frames
+    for step in ([0.5] * 7, [3.0, -2.0, 1.0, 0.0, 0.5, -0.25, 7.0]):  # near the box: computed
         assert arm.move_ptp_joint_rel(step).ok
         end = arm.device.queued_end.joints.tolist()
         kept_frames, joints, position = arm._posture_memo
         assert kept_frames is frames and joints == end
         assert position == _line_positions_mm(kin, frames, end, [0.0] * 7, [0.0])[0]
+    assert arm.move_ptp_joint_rel([-0.01] * 7).ok          # within 1 mm of the kept posture
+    assert arm._posture_memo[1] == end
+
+
+def short_moves_near_a_box(arm, seed: int) -> list:
+    """The replies (code, comment) and queued ends of 400 random short PTP moves (-0.3 … 0.5°
+    each joint: a drift) from the arm's posture, inside a box 240 mm wide around its control
+    point: near the kept posture at first, then into the box's sides."""
+    kin = shared_kinematics()
+    x, y, z = _line_positions_mm(kin, arm.frames, arm.device.queued_end.joints.tolist(),
+                                 [0.0] * 7, [0.0])[0]
+    assert arm.set_soft_limit_box((x - 120, x + 120, y - 120, y + 120, z - 120, z + 120)).ok
+    rng = np.random.default_rng(seed)
+    out = []
+    for _ in range(400):
+        r = arm.move_ptp_joint_rel(rng.uniform(-0.3, 0.5, 7).tolist())
+        out.append((r.code, r.comment, arm.device.queued_end.joints.tolist()))
+    return out
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_a_line_near_the_kept_posture_is_answered_as_its_samples_would_be(seed):
+    """The shortcut past the line's forward kinematics (`_line_near_kept_posture_inside`)
+    answers every move as the samples' check does: the same replies and queued ends as an arm
+    without it, over moves that often reach the box."""
+    from acti_motion.arm.core import ArmConfig, ArmCore
+    from acti_motion.executor import MotionExecutor
+    from acti_sim.world import World
+    runs, taken = [], []
+    for shortcut in (True, False):
+        world = World()
+        try:
+            a = ArmCore(MotionExecutor(world, real_time_factor=0.0),
+                        ArmConfig(queue_size=1000, initial_joints_deg=WORK))
+            assert a.servo_on().ok and a.set_speed_joint(50).ok
+            near = a._line_near_kept_posture_inside
+            a._line_near_kept_posture_inside = (
+                (lambda *args: taken.append(near(*args)) or taken[-1]) if shortcut
+                else (lambda *args: False))
+            runs.append(short_moves_near_a_box(a, seed))
+        finally:
+            world.close()
+    with_it, without = runs
+    assert with_it == without
+    assert 50 < sum(code == 0 for code, _, _ in with_it) < 350      # both kinds of answer
+    assert sum(taken) >= 10 and not all(taken)                       # both ways of checking

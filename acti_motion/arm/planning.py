@@ -259,11 +259,12 @@ class MovePlanning:
                 return np.asarray(_line_positions_mm(self.kin, frames, q0, delta, ss, position_at))
             ss = [k / (steps - 1) for k in range(steps)]   # every degree of the longest joint's way
             lim = self.soft_limit_cartesian
-            positions = _line_positions_mm(self.kin, frames, q0, delta, ss, position_at)
-            if not _well_inside(positions, self._limit_floats()[1], NEAR_LIMIT_MM):
-                self._check_cartesian_positions(_near_limits_refined(
-                    np.array(ss), np.asarray(positions), positions_mm, lim[:, 0], lim[:, 1],
-                    NEAR_LIMIT_MM), label)
+            if not self._line_near_kept_posture_inside(frames, q0, end):
+                positions = _line_positions_mm(self.kin, frames, q0, delta, ss, position_at)
+                if not _well_inside(positions, self._limit_floats()[1], NEAR_LIMIT_MM):
+                    self._check_cartesian_positions(_near_limits_refined(
+                        np.array(ss), np.asarray(positions), positions_mm, lim[:, 0], lim[:, 1],
+                        NEAR_LIMIT_MM), label)
             timing = Trapezoid.for_axes(delta, speed, ramp)
             return ArmMotion(path, timing, start.finger, start.finger, ramp, "joint")
         return self._submit(plan, label)
@@ -289,6 +290,25 @@ class MovePlanning:
         values = joints.tolist()
         self._joints_memo = (joints, values)
         return values
+
+    def _line_near_kept_posture_inside(self, frames: Frames, q0: list[float],
+                                       end: list[float]) -> bool:
+        """The joint line q0 → end (rad) keeps the control point more than NEAR_LIMIT_MM inside
+        the Cartesian soft limit, told without a posture's forward kinematics near the last
+        posture computed (`_position_at`): a joint turns the control point about an axis no
+        farther from it than the reach's radius, so a posture q lies within that radius times
+        ‖q − q_kept‖₁ of the kept position, and every posture of the line within the larger of
+        its ends' (the norm is convex). Where that ball is well inside, so is every sample the
+        line's check takes (the same answer); False sends the line to that check."""
+        memo = self._posture_memo
+        if memo is None or memo[0] is not frames:
+            return False
+        _, kept, position = memo
+        far = max(sum(map(abs, map(operator.sub, q0, kept))),
+                  sum(map(abs, map(operator.sub, end, kept))))
+        clear = far * self.planner.reach_radius(frames) * 1000.0 + NEAR_LIMIT_MM + 1e-6
+        box = self._limit_floats()[1]
+        return all(lo + clear < p < hi - clear for p, (lo, hi) in zip(position, box))
 
     def _position_at(self, frames: Frames, q: list[float]) -> list[float]:
         """The control point (mm) of posture q (rad) in `frames`; the last one computed is kept:
