@@ -13,6 +13,9 @@ a third figure, when the goal's result reached this client (which adds this clie
 delays: a storm takes both cores from it too). /clock gaps likewise: as the job sent them and as they
 arrived, beside the largest silence of a bare process that only publishes a Clock every control
 period, scheduled as the job's loop (`clock_floor.py`): what the machine allowed in that case.
+And `stop`'s time in the job: from its taking the request
+(the REQUEST_RECEIVED service event, introspection on as by default) to its answer (the
+response's source timestamp): what the control-plane rule bounds, free of this client's delays.
 Ratios are against the bare round trip and the control period measured in
 the same run (the /clock increment). Goals: stop reply p99 <= 3x bare, rest within the decel
 time + 2 control periods, /clock never silent for more than 2 control periods. A trial whose
@@ -23,6 +26,8 @@ clients that arrive before it takes its own loses it: the harness's keep 100, `C
     python bench/bench_control_plane.py            (a few minutes)
     python bench/bench_control_plane.py --cases cd (only cases (c) and (d))
     python bench/bench_control_plane.py --cases e  (only the program case)
+    python bench/bench_control_plane.py --cases f  (busy processes at the job's niceness: as
+                                                    other jobs on the machine, e.g. tests')
     python bench/bench_control_plane.py --storm S  (one storm client for S seconds: used by (d))
 """
 from __future__ import annotations
@@ -47,9 +52,10 @@ from acti_msgs.msg import CarPosWithElbow, VehiclePoint
 from action_msgs.msg import GoalStatus, GoalStatusArray
 from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosgraph_msgs.msg import Clock
+from service_msgs.msg import ServiceEventInfo
 
 from acti_bringup.serving.adapter import CLIENT_QOS
-from bench.clock_floor import FIFO_PRIORITY, TOPIC as BARE_CLOCK
+from bench.clock_floor import FIFO_PRIORITY, NICENESS, TOPIC as BARE_CLOCK
 from acti_bringup.serving.spinning import init, stop_requested
 
 ARM, BASE = "/acti_middle_node/", "/vehicle_node/"
@@ -57,6 +63,7 @@ TRIALS = 20
 MAX_GOALS = 4                       # max_action_goals and max_wait_goals of the job
 QUEUE = 8                           # queue_size of both devices
 STORM_CLIENTS = 8
+BUSY_PROCESSES = 3                  # case (f): CPU-bound processes at the job's niceness
 ARM_DECEL_S = 0.3                   # accel_time_joint
 BASE_DECEL_S = 300.0 / 500.0        # default velocity / default acceleration (translation)
 
@@ -102,6 +109,14 @@ class Background:
         for path in (ARM, BASE):
             self.node.create_subscription(GoalStatusArray, path + "wait_motion/_action/status",
                                           self._on_status, status_qos)
+        # when the job took each stop request (its service event's stamp, wall), per service
+        self.stops_taken: dict[str, list[float]] = {ARM + "stop": [], BASE + "stop": []}
+        for name, stop in ((ARM + "stop", srv.Stop), (BASE + "stop", srv.VehicleStop)):
+            self.node.create_subscription(
+                stop.Event, name + "/_service_event",
+                lambda e, taken=self.stops_taken[name]: taken.append(
+                    e.info.stamp.sec + e.info.stamp.nanosec * 1e-9)
+                if e.info.event_type == ServiceEventInfo.REQUEST_RECEIVED else None, 100)
         self.executor = SingleThreadedExecutor()
         self.executor.add_node(self.node)
         self._clients: dict[str, Any] = {}
@@ -140,6 +155,12 @@ class Background:
         bare = bare[(bare >= sent[0]) & (bare <= sent[-1])]
         bare_gap = float(np.max(np.diff(bare))) if len(bare) > 1 else float("inf")
         return float(np.max(np.diff(sent))), float(np.max(np.diff(arrived[inside]))), bare_gap
+
+    def stop_taken(self, service: str, since: float, until: float) -> float | None:
+        """When the job took the stop request it answered at `until` (wall), asked after
+        `since`: only this bench's main client calls stop."""
+        taken = [t for t in self.stops_taken[service] if since - 0.05 <= t <= until]
+        return taken[-1] if taken else None
 
     def control_period(self) -> float:
         return float(np.median(np.diff(np.array(self.clock_values[-500:]))))
@@ -221,6 +242,7 @@ class Figures:
     rest: list[float]    # stop called → the wait's result here
     rest_job: list[float]    # stop called → the job said the wait ended (status source stamp)
     rest_answered: list[float]   # the job answered stop → it said the wait ended (both stamps)
+    in_job: list[float]  # the job took stop → it answered (its service event, its response)
     clock_gap: float     # the job's largest /clock silence (source timestamps)
     clock_arrival_gap: float     # ... as seen by this client
     bare_clock_gap: float        # the bare publisher's largest silence meanwhile
@@ -262,10 +284,10 @@ def running_motion(ros: RosClient, device: Device, waiter: Actions,
 
 def run_trials(ros: RosClient, bg: Background, device: Device, load: Load,
                waiter: Actions) -> Figures:
-    f = Figures([], [], [], [], [], 0.0, 0.0, 0.0, [])
+    f = Figures([], [], [], [], [], [], 0.0, 0.0, 0.0, [])
     for trial in range(-1, TRIALS):                     # trial -1 warms up (lazy imports)
         if trial == 0:
-            f, t0 = Figures([], [], [], [], [], 0.0, 0.0, 0.0, []), time.monotonic()
+            f, t0 = Figures([], [], [], [], [], [], 0.0, 0.0, 0.0, []), time.monotonic()
         try:
             trial_figures(ros, bg, device, load, waiter, trial, f)
         except TimeoutError as e:
@@ -299,6 +321,9 @@ def trial_figures(ros: RosClient, bg: Background, device: Device, load: Load, wa
     f.rest_job.append(bg.goal_ended[uuid] - wall)
     if answered is not None:
         f.rest_answered.append(bg.goal_ended[uuid] - answered)
+        service = device.path + "stop"
+        if ros.spin_until(lambda: bg.stop_taken(service, wall, answered) is not None, 5.0):
+            f.in_job.append(answered - bg.stop_taken(service, wall, answered))
     ros.call(device.stop_srv, device.path + "stop")     # what a load queued meanwhile
     if isinstance(held, list):
         for future in held:                              # held goals end with the motion
@@ -341,6 +366,22 @@ def storm(seconds: float) -> Iterator[None]:
              for _ in range(STORM_CLIENTS)]
     try:
         time.sleep(5.0)                     # the storm clients found the nodes and run
+        yield
+    finally:
+        for proc in procs:
+            proc.terminate()
+            proc.wait(timeout=30)
+
+
+@contextmanager
+def busy_processes(count: int) -> Iterator[None]:
+    """`count` processes that only compute, at the job's niceness (as other jobs on the
+    machine, say a test suite's, run): what the job's threads compete with on equal terms."""
+    procs = [subprocess.Popen([sys.executable, "-c",
+                               f"import os; os.nice({NICENESS}); exec('while True: pass')"])
+             for _ in range(count)]
+    try:
+        time.sleep(1.0)
         yield
     finally:
         for proc in procs:
@@ -400,6 +441,8 @@ def scenarios(ros: RosClient, bg: Background,
         "(c) the most action goals held": (most_goals, nullcontext),
         "(d) 8 clients storm getters and moves": (nothing, lambda: storm(seconds=600.0)),
         "(e) a STROLIC program computes": (nothing, lambda: busy_program(ros)),
+        f"(f) {BUSY_PROCESSES} busy processes at niceness {NICENESS}":
+            (nothing, lambda: busy_processes(BUSY_PROCESSES)),
     }
 
 
@@ -440,8 +483,8 @@ def main(cases: str) -> None:
         print(f"stop under load, main job, {TRIALS} trials per case; control period "
               f"{period * 1e3:.2f} ms (from /clock); times in ms")
         print(f"{'case':<40} {'dev':<5} {'bare p50/p99':>15} {'stop reply p50/p99/max':>25} "
-              f"{'ratio p99':>9} {'rest p50/p99/max':>25} {'goal':>7} {'answered→p99':>12} "
-              f"{'received p99':>12} {'/clock gap':>10}")
+              f"{'ratio p99':>9} {'in job p50/p99/max':>22} {'rest p50/p99/max':>25} {'goal':>7} "
+              f"{'answered→p99':>12} {'received p99':>12} {'/clock gap':>10}")
         # one action client per device for the whole run: each new one would add entities to
         # both processes (and receivers of every goal status) for the rest of the run
         waiters = {d.name: Actions(ros, d.wait_action, d.path + "wait_motion") for d in DEVICES}
@@ -454,10 +497,12 @@ def main(cases: str) -> None:
                     f = run_trials(ros, bg, device, load, waiters[device.name])
                     drops = udp_receive_drops() - drops
                     reply, rest = np.array(f.reply), np.array(f.rest_job)
+                    in_job = np.array(f.in_job or [np.nan])
                     goal = device.decel_s + 2 * period
                     print(f"{name:<40} {device.name:<5} {p(np.array(f.bare), 50):7.2f}/"
                           f"{p(np.array(f.bare), 99):7.2f} {p(reply, 50):7.2f}/{p(reply, 99):7.2f}/"
                           f"{reply.max() * 1e3:8.2f} {p(reply, 99) / p(np.array(f.bare), 99):9.2f}"
+                          f" {p(in_job, 50):6.2f}/{p(in_job, 99):6.2f}/{np.max(in_job) * 1e3:7.2f}"
                           f" {p(rest, 50):7.1f}/{p(rest, 99):7.1f}/{rest.max() * 1e3:7.1f}"
                           f" {goal * 1e3:7.1f} {p(np.array(f.rest_answered or [np.nan]), 99):12.1f}"
                           f" {p(np.array(f.rest), 99):12.1f}"
