@@ -4,7 +4,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from acti_motion.arm.poses import hg_to_pose, pose_to_hg
+from acti_motion.arm.poses import EXACT_ROTATION, ROTATION_TOLERANCE, hg_to_pose, pose_to_hg
 from acti_motion.replies import Refused, ReturnCode as R
 
 TURNED = pin.exp3(np.array([0.3, -0.5, 0.9]))
@@ -59,3 +59,48 @@ def test_a_value_that_is_no_number_is_refused_by_its_place():
     with pytest.raises(Refused) as e:
         hg_to_pose(values, "p")
     assert e.value.comment == "p[5] is nan: every value must be a finite number"
+
+
+def hg_to_pose_in_numpy(values, name):
+    """hg_to_pose as it was, all in numpy: the reference for the plain-float one."""
+    m = np.array(values, dtype=float).reshape(3, 4)
+    R = m[:, :3]
+    largest = float(np.abs(R).max())
+    if largest > 1.0 + ROTATION_TOLERANCE:
+        return (f"{name}: the 3×3 part is not a rotation: an entry is {largest:.6g}, a "
+                f"rotation's are within ±1")
+    gram = R.T @ R
+    gram.flat[::4] -= 1.0
+    err = float(np.abs(gram).max())
+    det = float(np.linalg.det(R))
+    if err > ROTATION_TOLERANCE or det <= 0:
+        return err, det
+    T = np.eye(4)
+    if err > EXACT_ROTATION:
+        u, _, vt = np.linalg.svd(R)
+        R = u @ vt
+    T[:3, :3] = R
+    T[:3, 3] = m[:, 3] / 1000.0
+    return T
+
+
+def test_the_pose_read_in_plain_floats_is_numpy_s():
+    """The same pose to the last bit, the same refusals (their |RᵀR − I| to the last bit too),
+    on rotations, near-rotations (made orthonormal), scaled and mirrored ones."""
+    rng = np.random.default_rng(21)
+    for k in range(400):
+        R = pin.exp3(rng.normal(0, 2, 3)) * (1 + rng.choice([0.0, 1e-12, 1e-6, 1e-4, 0.01]))
+        if k % 5 == 0:
+            R = R @ np.diag([1.0, 1.0, -1.0])
+        values = np.hstack([R, rng.normal(0, 1000, (3, 1))]).reshape(-1).tolist()
+        want = hg_to_pose_in_numpy(values, "p")
+        if isinstance(want, np.ndarray):
+            assert np.array_equal(hg_to_pose(values, "p"), want)
+            continue
+        with pytest.raises(Refused) as e:
+            hg_to_pose(values, "p")
+        if isinstance(want, str):
+            assert e.value.comment == want
+        else:
+            err, det = want
+            assert f"|RᵀR − I| = {err:.3g}, det = " in e.value.comment
