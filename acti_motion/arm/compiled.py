@@ -25,7 +25,9 @@ TWO_PI = 2.0 * math.pi
 _A1 = types.Array(float64, 1, "A", readonly=True)
 _A2 = types.Array(float64, 2, "A", readonly=True)
 _A3 = types.Array(float64, 3, "A", readonly=True)
-_KERNEL = {"cache": True, "nogil": True, "error_model": "numpy"}
+# The GIL kept: a kernel runs ~1 µs, and releasing it would let another thread (the simulation's)
+# take the GIL in the middle of an accept.
+_KERNEL = {"cache": True, "error_model": "numpy"}
 
 
 def _kernel(signature):
