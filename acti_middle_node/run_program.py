@@ -108,22 +108,22 @@ def run(args: argparse.Namespace) -> int:
         print(f"{args.program}: {error}", file=sys.stderr)
         return 2
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)   # Ctrl-C: cancel, then report
-    node = rclpy.create_node("run_program")
-    if args.check:
-        try:
+    node = client = None
+    try:        # a Ctrl-C from here on is one line: also while the client is being made (its
+        # node is in the graph before then: a traceback came out of the type support's import)
+        node = rclpy.create_node("run_program")
+        if args.check:
             return check(args, fields, node)
-        finally:
-            node.destroy_node()
-            rclpy.try_shutdown()
-    client = ActionClient(node, RunProgram, f"{args.node.rstrip('/')}/run_program")
-    try:
+        client = ActionClient(node, RunProgram, f"{args.node.rstrip('/')}/run_program")
         return _send_and_follow(args, fields, node, client)
     except KeyboardInterrupt:       # before the program was sent, or again while canceling
         print("interrupted", file=sys.stderr)
         return 2
     finally:
-        client.destroy()
-        node.destroy_node()
+        if client is not None:
+            client.destroy()
+        if node is not None:
+            node.destroy_node()
         rclpy.try_shutdown()
 
 
