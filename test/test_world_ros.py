@@ -50,13 +50,14 @@ def state(ros, ns=""):
 def ready(ros, ns=""):
     assert call(ros, "set_power", ns, on_off=True).success
     assert call(ros, "set_servo", ns, on_off=True).success
-    assert wait_until(lambda: state(ros, ns) == 0x010, 10.0)
+    assert wait_until(lambda: state(ros, ns) == 0x010, 30.0)   # a condition: 30 s under load
 
 
 class Latest:
-    """The messages of one topic, kept as they come."""
+    """The messages of one topic, kept as they come (a deep history: a test process starved
+    under load must not lose the samples it checks, such as a speed's peak)."""
 
-    def __init__(self, ros, msg_type, topic, qos=10):
+    def __init__(self, ros, msg_type, topic, qos=1000):
         self.ros, self.got = ros, []
         self.sub = ros.node.create_subscription(msg_type, topic, self.got.append, qos)
 
