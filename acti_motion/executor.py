@@ -627,6 +627,11 @@ class MotionExecutor:
     # more than an idle step (the sleep, cold caches: ~3x a step's Python work), and a step that
     # commands nothing changes nothing by running later: the physics is the same step by step.
     IDLE_WAKE_S = 0.02
+    # Woken by work, it first lets the thread that gave it answer (a move's accept: its reply
+    # and send), then catches up: the steps it slept over, run back to back, held the core and
+    # the GIL while that answer went out. They lie before the work came: running them this much
+    # later changes nothing they command.
+    WORK_GRACE_S = 0.001
 
     def __init__(self, world: World, real_time_factor: float = 1.0,
                  alive: Callable[[], bool] = lambda: True) -> None:
@@ -731,7 +736,8 @@ class MotionExecutor:
             self._work.clear()          # before looking: work given from now on wakes the wait
             idle_steps = self._idle_steps() if ahead > 0 else 0
             if idle_steps:
-                self._work.wait(ahead + idle_steps * self.dt / self.real_time_factor)
+                if self._work.wait(ahead + idle_steps * self.dt / self.real_time_factor):
+                    time.sleep(self.WORK_GRACE_S)
             else:
                 # Sleeping (even 0 s) hands the GIL to service threads once per step.
                 time.sleep(max(ahead, 0.0))

@@ -75,6 +75,20 @@ def test_work_wakes_an_idle_loop_at_once(loop):
     assert loop.steps - before >= 60
 
 
+def test_woken_by_work_the_loop_lets_the_giver_answer_before_it_steps(loop):
+    """The steps an idle loop slept over run after a grace (`WORK_GRACE_S`): run at once,
+    back to back, they held the core while the accept's answer went out. Made long here."""
+    loop.IDLE_WAKE_S, loop.WORK_GRACE_S = LONG_WAKE_S, 2.0
+    loop.start()
+    assert wait_for(lambda: loop.steps > 0, 2.0)
+    time.sleep(0.2)                             # asleep now, until LONG_WAKE_S
+    before = loop.steps
+    loop.device.submit(lambda start: Hold(1.0), "hold")
+    time.sleep(0.1)                             # the giver answers (the GIL is free)
+    assert loop.steps == before
+    assert wait_for(lambda: loop.device.current is not None, 5.0)
+
+
 def test_a_motion_over_at_once_leaves_an_idle_loop_asleep(loop):
     """A zero-length motion on an idle device is over when it is accepted: nothing for the loop
     to command, so it is not woken (woken, it stepped the steps it slept over back to back
