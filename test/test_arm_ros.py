@@ -219,8 +219,12 @@ def test_state_topic(ros, arm_node):
 def test_pause_resume_and_queue_full_over_dds(ros, arm_node, wait_motion):
     ready(ros)
     call(ros, "set_speed_joint", srv.SetSpeedJoint, spd_ratio=20)
+    start = call(ros, "get_feedback_pos_joint", srv.GetFeedbackPosJoint).pos[0]
     ids = [call(ros, "move_ptp_joint_rel", srv.MovePTPJointRel, joint_points=[8.0] * 7).motion_id]
-    assert wait_until(lambda: call(ros, "get_state", srv.GetState).state & 0x02, 10.0)
+    # under way (the state word says moving as soon as it is queued: paused before its first
+    # step, it stayed in the queue and took a fifth place there)
+    assert wait_until(lambda: call(ros, "get_feedback_pos_joint", srv.GetFeedbackPosJoint)
+                      .pos[0] > start + 0.05, 10.0)
     assert call(ros, "pause", srv.Pause).return_id.id == 0
     assert wait_until(lambda: call(ros, "get_state", srv.GetState).state & 0x12 == 0x10, 10.0)
     while True:                                   # queue_size 4: the fifth is refused
