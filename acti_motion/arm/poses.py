@@ -36,7 +36,7 @@ def hg_to_pose(values: Iterable[float], name: str,
     except Refused as r:
         raise Refused(code, r.comment) from None
     rows = [v[0:3], v[4:7], v[8:11]]          # plain floats where they serve: fewer numpy calls
-    largest = max(abs(x) for row in rows for x in row)
+    largest = max(map(abs, rows[0] + rows[1] + rows[2]))
     if largest > 1.0 + ROTATION_TOLERANCE:      # no rotation has such entries
         raise Refused(code, f"{name}: the 3×3 part is not a rotation: an entry is "
                             f"{largest:.6g}, a rotation's are within ±1")
