@@ -44,17 +44,19 @@ setup:
 	$(SUBMAKE) -j2 stage-interfaces stage-wheels && \
 	$(STAGE) "the parameters list --help prints (kept in build/usage/)" $(SETUP_LOG)/usage.log \
 	  bash -c '$(ENV) && python -m acti_bringup --help' && \
-	$(STAGE) "the CP plan's compiled kernels (numba's cache)" $(SETUP_LOG)/kernels.log \
-	  bash -c '$(ENV) && python -m acti_motion.arm.compiled' && \
 	took=$$((SECONDS - start)) && printf 'setup done in %d:%02d\n' $$((took / 60)) $$((took % 60))
 
 stage-interfaces:
 	@+$(STAGE) "interfaces: acti_msgs and the standard ones PyPI lacks" $(SETUP_LOG)/interfaces.log \
 	  $(SUBMAKE) $(BUILD_STAMP)
 
+# The CP plan's kernels need only numpy and numba: compiled into numba's cache while the
+# interfaces build (~20 s of a fresh checkout's setup; every later start loads them).
 stage-wheels:
 	@+$(STAGE) "the rest of the venv (PyBullet, Pinocchio, TOPP-RA, viser)" $(SETUP_LOG)/wheels.log \
-	  $(SUBMAKE) $(DEPS_STAMP)
+	  $(SUBMAKE) $(DEPS_STAMP) && \
+	$(STAGE) "the CP plan's compiled kernels (numba's cache)" $(SETUP_LOG)/kernels.log \
+	  $(PY) -m acti_motion.arm.compiled
 
 # pip's HTTP cache keeps nothing from this registry, so the wheels are kept in a wheelhouse: a new
 # venv (another clone, `rm -r .venv`) installs from it without the network; the lock pins every
