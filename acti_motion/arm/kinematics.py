@@ -178,8 +178,10 @@ class ArmKinematics:
             return last[1]
         d = self.data                         # in plain floats: a few 3-vectors
         pin.forwardKinematics(self.model, d, q)
-        (sx, sy, sz), (ex, ey, ez), (wx, wy, wz) = (d.oMi[i].translation.tolist()
-                                                     for i in (2, 4, 6))
+        oMi = d.oMi
+        sx, sy, sz = oMi[2].translation.tolist()
+        ex, ey, ez = oMi[4].translation.tolist()
+        wx, wy, wz = oMi[6].translation.tolist()
         ux, uy, uz = wx - sx, wy - sy, wz - sz
         r = math.sqrt(ux * ux + uy * uy + uz * uz)
         ux, uy, uz = ux / r, uy / r, uz / r
@@ -195,8 +197,8 @@ class ArmKinematics:
         return u, n
 
     def angle_of(self, u: np.ndarray, n: np.ndarray) -> float:
-        e1, e2 = self._reference_floats(*map(float, u))
-        n0, n1, n2 = map(float, n)
+        e1, e2 = self._reference_floats(*u.tolist())
+        n0, n1, n2 = n.tolist()
         return math.atan2(n0 * e2[0] + n1 * e2[1] + n2 * e2[2],
                           n0 * e1[0] + n1 * e1[1] + n2 * e1[2])
 
