@@ -232,3 +232,33 @@ def test_the_spline_on_a_unit_grid_by_its_kept_map_is_the_solved_one():
         assert np.array_equal(got[3], ys[:-1])                     # through the samples
         still = not_a_knot_on_unit_grid(np.tile(ys[0], (n, 1)))      # a move that stays
         assert not still[:3].any() and np.array_equal(still[3], np.tile(ys[0], (n - 1, 1)))
+
+
+def test_a_cp_plan_follows_each_setting_change(executor):  # noqa: F811
+    """A CP move's limits are kept between accepts (`_cartesian_limits`): each setting's change
+    is in the next plan, and its return gives the first plan's timing again."""
+    arm = ArmCore(executor, ArmConfig(initial_joints_deg=tuple(np.degrees(WORK))))
+    arm.servo_on()
+    assert arm.set_accel_time_cartesian(0.1).ok
+    sign = [1.0]
+
+    def duration() -> float:
+        sign[0] = -sign[0]
+        m = np.eye(4)
+        m[0, 3] = 0.1 * sign[0]
+        assert arm.move_linear_cartesian_rel((pose_to_hg(m), 0.0, 0)).ok
+        return arm.device.queue[-1].motion.timing.duration
+    changes = [(arm.set_speed_cartesian, 20, 60), (arm.set_max_speed_cartesian, (100.0, 90.0),
+                                                   (400.0, 90.0)),
+               (arm.set_accel_time_cartesian, 0.3, 0.1)]
+    for setter, first, second in changes:
+        assert setter(first).ok
+        before = duration()
+        assert setter(second).ok
+        assert duration() != pytest.approx(before)
+        assert setter(first).ok
+        assert duration() == before
+    assert arm.set_max_speed_joint([1.0] * 7).ok      # the joints' limits: time-optimal, slower
+    slow = duration()
+    assert slow > before and arm.set_max_speed_joint(list(arm.hard_max_speed_joint)).ok
+    assert duration() == before

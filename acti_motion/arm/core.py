@@ -116,6 +116,8 @@ class ArmCore(SoftLimitWatch, MovePlanning):
         self._posture_memo = None                     # a PTP plan's last posture: `_position_at`
         self._joints_memo = None                      # a set-point's joints as floats
         self._speeds_memo = None                      # the joints' speeds at a ratio
+        self._reach_memo = None                       # the reach's ball in the robot frame
+        self._limits_memo = None                      # a CP move's limits at its settings
         executor.after_step(self._sample)
 
     def _apply_settings(self, c: ArmConfig) -> None:

@@ -70,6 +70,13 @@ def _well_inside(values: np.ndarray | list[list[float]], bounds: np.ndarray | li
                for row in rows)
 
 
+def _clear_of_joint_limits(lj: np.ndarray, lc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(lower, upper) (rad) of the joints NEAR_LIMIT_DEG inside their soft limits `lj` (degree,
+    rows: joints): what a CP spline's bound keeps clear of (`lc` unused)."""
+    clear = np.radians(lj + _NEAR_JOINT_LIMIT)
+    return clear[:, 0], clear[:, 1]
+
+
 def _position_mm(pose: np.ndarray) -> list[float]:
     """The position of a pose (4×4, m) in mm, in plain floats (one numpy call)."""
     rows = pose.tolist()
@@ -121,6 +128,8 @@ class MovePlanning:
     _posture_memo: tuple[Frames, list[float], list[float]] | None   # (frames, joints, position)
     _joints_memo: tuple[np.ndarray, list[float]] | None             # (set-point joints, floats)
     _speeds_memo: tuple[np.ndarray, float, list[float]] | None      # (rated, ratio, speeds)
+    _reach_memo: tuple[Frames, list[float], float] | None          # (frames, shoulder, radius)
+    _limits_memo: tuple[np.ndarray, tuple, CartesianLimits] | None  # (rated, settings, limits)
 
     # === checks ======================================================================================
     def _limit_floats(self) -> tuple[list[list[float]], list[list[float]], list[list[float]]]:
@@ -170,14 +179,17 @@ class MovePlanning:
         """Control-point positions (robot frame, m) no farther from the shoulder than the arm,
         hand and control-point offset reach, else VALUE_ERR: checked before any IK or planning,
         so a target kilometres away is refused at once."""
-        kin = self.kin
-        to_robot = frames.base_inverse
-        shoulder = to_robot[:3, :3] @ kin.shoulder + to_robot[:3, 3]
-        radius = self.planner.reach_radius(frames)
+        memo = self._reach_memo                       # made again when the frames change
+        if memo is None or memo[0] is not frames:
+            to_robot = frames.base_inverse
+            memo = self._reach_memo = (frames, (to_robot[:3, :3] @ self.kin.shoulder
+                                                + to_robot[:3, 3]).tolist(),
+                                       self.planner.reach_radius(frames))
+        _, centre, radius = memo
         if len(positions) <= FEW_POSTURES:            # a target, a line's ends: plain floats
-            centre = shoulder.tolist()
             if all(math.dist(p, centre) <= radius for p in positions.tolist()):
                 return
+        shoulder = np.array(centre)
         dist = np.linalg.norm(positions - shoulder, axis=1)
         far = np.flatnonzero(~(dist <= radius + 1e-9))
         if len(far):
@@ -221,8 +233,7 @@ class MovePlanning:
         each piece keeps it clear of them (as the samples would find), else at 4 samples per
         IK sample, finer near a limit."""
         lim = self.soft_limit_joint
-        clear = np.radians(lim + _NEAR_JOINT_LIMIT)      # rows: joints; lower, upper
-        if spline_within(spline, clear[:, 0], clear[:, 1]):
+        if spline_within(spline, *self._for_limits("_clear_made", _clear_of_joint_limits)):
             return
         dense = np.linspace(0.0, 1.0, 4 * len(spline.ss))
 
@@ -361,20 +372,29 @@ class MovePlanning:
                 raise value_error(f"{label}: {e}") from None
         return self.queue_joint_move(goal_of, label)
 
+    def _cartesian_limits(self, speed_ratio: float, ramp: float) -> CartesianLimits:
+        """The CP profile's limits at a speed ratio (%) and accel time (s), made again only when
+        these or a rated speed or the joints' accel time changed (each setter assigns anew)."""
+        key = (speed_ratio, ramp, self.max_speed_cartesian, self.min_accel_time_joint)
+        memo = self._limits_memo
+        if memo is None or memo[0] is not self.max_speed_joint or memo[1] != key:
+            (v, w), ratio = self.max_speed_cartesian, speed_ratio / 100.0
+            joint_velocity = np.radians(self.max_speed_joint)
+            memo = self._limits_memo = (self.max_speed_joint, key, CartesianLimits(
+                speed=v * ratio / 1000.0, angular_speed=math.radians(w * ratio), ramp=ramp,
+                joint_velocity=joint_velocity,
+                joint_accel=joint_velocity / self.min_accel_time_joint))
+        return memo[2]
+
     def queue_cartesian(self, path_of: Callable[[np.ndarray], CartesianPath], label: str, *,
                          psi: float | None = None, turn: float = 0.0,
                          speed_ratio: float | None = None, ramp: float | None = None) -> dict:
         """A CP move along path_of(start pose); the elbow ends at arm angle `psi`, or (Rel) is
         turned by `turn` (rad) from where it starts. Speed ratio and accel time: the port's
         settings unless given."""
-        v, w = self.max_speed_cartesian
-        ratio = (self.speed_cartesian if speed_ratio is None else speed_ratio) / 100.0
-        ramp = self.accel_time_cartesian if ramp is None else ramp
-        joint_velocity = np.radians(self.max_speed_joint)
-        limits = CartesianLimits(
-            speed=v * ratio / 1000.0, angular_speed=math.radians(w * ratio), ramp=ramp,
-            joint_velocity=joint_velocity,
-            joint_accel=joint_velocity / self.min_accel_time_joint)
+        limits = self._cartesian_limits(
+            self.speed_cartesian if speed_ratio is None else speed_ratio,
+            self.accel_time_cartesian if ramp is None else ramp)
 
         def plan(start: ArmSetpoint) -> ArmMotion:
             frames = self.frames          # read while planning: the offsets wait for it
@@ -398,7 +418,7 @@ class MovePlanning:
             except Unreachable as e:
                 raise value_error(f"{label}: {e}") from None
             self._check_joint_spline(result.path, label)
-            return ArmMotion(result.path, result.timing, start.finger, start.finger, ramp,
+            return ArmMotion(result.path, result.timing, start.finger, start.finger, limits.ramp,
                              "cartesian")
         return self._submit(plan, label)
 
