@@ -159,11 +159,13 @@ def _unit_grid_map(n: int) -> np.ndarray:
     return not_a_knot_coefficients(unit_grid(n), np.eye(n))[:3].copy()
 
 
+@functools.lru_cache(maxsize=256)
 def unit_grid(n: int) -> np.ndarray:
     """np.linspace(0.0, 1.0, n) for n ≥ 2, the same values (its arithmetic), without the cost
-    of its general form (twice in every CP plan)."""
+    of its general form; kept per n, read-only (twice in every CP plan, a few sizes)."""
     grid = np.arange(n, dtype=float) * (1.0 / (n - 1))
     grid[-1] = 1.0
+    grid.flags.writeable = False
     return grid
 
 
