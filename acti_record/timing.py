@@ -8,14 +8,15 @@ milliseconds earlier or later, and the device is that much further on. Every inp
 a message published); what it missed by is measured on the same clock in both runs
 (`Plan.errors_s`). While the recording shows its device moving, that error moves the device
 by up to its speed times the error, and the difference stays in every later read of the device
-(a stop given late leaves the base further on for good): `Plan.allowances`."""
+(a stop given late leaves the base further on for good): `Plan.allowances`, until a move to an
+absolute place that the device finished puts it where the recording had it (`Plan.arrivals`)."""
 from __future__ import annotations
 
 import bisect
 import math
 import statistics
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Any, Callable
 
 from acti_record.calls import Call
 from acti_record.reading import Message
@@ -87,6 +88,16 @@ class SpeedTrack:
                 return t
         return None
 
+    def settled(self, t0: float, t1: float, by: float) -> float | None:
+        """When the device came to rest after moving, after t0, to stay at rest (within `by`)
+        until t1: the first sample of that rest; None when it did not move after t0 or was still
+        moving before t1."""
+        i0, i1 = bisect.bisect_right(self.times, t0), bisect.bisect_left(self.times, t1)
+        moving = [j for j in range(i0, i1) if self.speeds[j] > by]
+        if not moving or moving[-1] + 1 >= i1:
+            return None
+        return self.times[moving[-1] + 1]
+
     def peak(self, t0: float, t1: float) -> float:
         """The highest speed from t0 to t1, the samples on either side included."""
         i0 = max(bisect.bisect_left(self.times, t0) - 1, 0)
@@ -95,6 +106,34 @@ class SpeedTrack:
 
 
 NEVER = float("-inf")
+ARRIVAL = "arrival"         # an arrival's mark among an allowance's events (not an input)
+
+# Moves whose end is a place of their own, whatever the start (the arm's elbow is given with a
+# Cartesian target; the base's target has its heading): once one is over, its device is where the
+# recording had it. Not the base's cruise: its end heading follows the path from the start.
+ABSOLUTE_MOVES = frozenset({"move_ptp_joint_abs", "move_ptp_cartesian_abs",
+                            "move_linear_cartesian_abs", "move_circular_cartesian_abs", "go_home",
+                            "move_linear_abs"})
+WAITS = frozenset({"wait_motion"})          # actions that only wait for a device
+
+
+def operation_of(service: str) -> str:
+    """The operation a service (an action's too) serves: its last name."""
+    return service.split("/_action/", 1)[0].rsplit("/", 1)[-1]
+
+
+def is_command(service: str) -> bool:
+    """A call that may change what its device does: anything but a getter or a wait."""
+    name = operation_of(service)
+    return not (name.startswith("get_") or name in WAITS)
+
+
+def accepted(response: Any) -> bool:
+    """The recorded answer accepted the request: the arm's RETURN_ID OK, the base's true."""
+    return_id = getattr(response, "return_id", None)
+    if return_id is not None:
+        return return_id.id == 0
+    return bool(getattr(response, "success", False))
 
 
 class Plan:
@@ -121,6 +160,12 @@ class Plan:
         self.nth_of_service = [sum(1 for earlier in calls[:k] if earlier.service == c.service)
                                for k, c in enumerate(calls)]
         self.input_of = {k: n for n, (kind, k) in enumerate(self.inputs) if kind == "call"}
+        # per input: it may change what its device does (a command message always may), and
+        # it is an accepted move to an absolute place
+        self.commanding = [kind == "message" or is_command(calls[k].service)
+                           for kind, k in self.inputs]
+        self.absolute = [kind == "call" and operation_of(calls[k].service) in ABSOLUTE_MOVES
+                         and accepted(calls[k].response) for kind, k in self.inputs]
         self.event_of = [event for *_, event, _ in items]
         self.devices = [device for *_, device in items]
         self.sim_ns = [clock.sim_at(t) for t in self.recorded_ns]
@@ -183,32 +228,63 @@ class Plan:
                 out.append((rec, ((rep - t_rep) - (rec - t_rec)) / 1e9))
         return out
 
+    def arrivals(self, device: str, track: SpeedTrack, by: float) -> list[float]:
+        """When the device, in the recording, came to rest at the end of an accepted move to an
+        absolute place (`ABSOLUTE_MOVES`) and stayed there until its next command (`SpeedTrack.
+        settled`): from then on it is where the recording had it, whatever the timing before.
+        A stop or another move before it rested (a command) ends nothing."""
+        mine = [n for n, d in enumerate(self.devices) if d == device and self.commanding[n]]
+        out = []
+        for k, n in enumerate(mine):
+            if self.absolute[n]:
+                t1 = self.sim_ns[self.event_of[mine[k + 1]]] if k + 1 < len(mine) else math.inf
+                rest = track.settled(self.sim_ns[self.event_of[n]], t1, by)
+                if rest is not None:
+                    out.append(rest)
+        return out
+
     def allowances(self, errors_s: list[float], peak_speed: Callable[[str, float, float], float],
-                   margin_s: float, reactions: dict[str, list[tuple[float, float]]] | None = None
-                   ) -> list[float]:
+                   margin_s: float, reactions: dict[str, list[tuple[float, float]]] | None = None,
+                   arrivals: dict[str, list[float]] | None = None) -> list[float]:
         """For each input, how far its device may be from where the recording had it once the
         input is made: the sum, over the device's timed events up to this one (its inputs and
         its reactions, `reaction_errors`), of (|error| + margin_s) times the
         device's highest recorded speed from the event before to the event after (while that
         event's timing can matter); a timing error moves a device for good (a stop given late
-        leaves the base further on)."""
-        events = [(self.sim_ns[e], n, self.devices[n], errors_s[n])
-                  for n, e in enumerate(self.event_of)]
+        leaves the base further on). An arrival at an absolute place (`arrivals`) ends it: the
+        device's events from then on start from nothing, once the replay's device has arrived
+        too (it may run late by the sum of its timing errors so far, margins included) and
+        unless a command of it came before that."""
+        events = [(self.sim_ns[e], n, device, errors_s[n])
+                  for n, (e, device) in enumerate(zip(self.event_of, self.devices))]
         events += [(t, None, device, error) for device, found in (reactions or {}).items()
                    for t, error in found]
+        events += [(t, ARRIVAL, device, 0.0) for device, found in (arrivals or {}).items()
+                   for t in found]
         events.sort(key=lambda item: item[0])
-        own: dict[str, list[int]] = {}
-        for i, (_, _, device, _) in enumerate(events):
-            own.setdefault(device, []).append(i)
+        own: dict[str, list[tuple]] = {}
+        for event in events:
+            own.setdefault(event[2], []).append(event)
         drift: dict[str, float] = {}
+        late: dict[str, float] = {}             # the device's timing errors so far, s
+        over: dict[str, float] = {}             # its drift is over for events from then on
         out = [0.0] * len(self.event_of)
-        for i, (t, n, device, error) in enumerate(events):
+        for event in events:
+            t, n, device, error = event
+            if n == ARRIVAL:
+                over[device] = t + late.get(device, 0.0) * 1e9
+                continue
+            if device in over and (t >= over[device] or n is not None and self.commanding[n]):
+                if t >= over[device]:
+                    drift[device] = late[device] = 0.0
+                del over[device]        # a command before the replay's device surely arrived
             mine = own[device]
-            k = mine.index(i)
-            t0 = events[mine[k - 1]][0] if k else t
-            t1 = events[mine[k + 1]][0] if k + 1 < len(mine) else t
+            k = mine.index(event)
+            t0 = mine[k - 1][0] if k else t
+            t1 = mine[k + 1][0] if k + 1 < len(mine) else t
             drift[device] = drift.get(device, 0.0) + \
                 peak_speed(device, t0, t1) * (abs(error) + margin_s)
+            late[device] = late.get(device, 0.0) + abs(error) + margin_s
             if n is not None:
                 out[n] = drift[device]
         return out

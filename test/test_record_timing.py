@@ -1,6 +1,8 @@
 """The timing of a replay: the job's simulated time read from its /clock, each input's anchor,
 the answers it waits for, when it is due, its measured error, and what that error allows a
 device's later reads."""
+from types import SimpleNamespace
+
 import pytest
 
 from acti_record.calls import Call
@@ -143,3 +145,73 @@ def test_the_jobs_own_reaction_time_is_timed_in_both_runs():
     allowed = plan.allowances([0.0] * 7, lambda d, t0, t1: speeds[d].peak(t0, t1) if d in speeds
                               else 0.0, 0.0, {"/base": found})
     assert allowed[3] == pytest.approx(500 * 0.050 + 500 * 0.120)    # the read after the stop
+
+
+def answered(id_: int) -> SimpleNamespace:
+    return SimpleNamespace(return_id=SimpleNamespace(id=id_, comment=""))
+
+
+def arm_plan(*calls_ms: tuple[str, int, int]) -> Plan:
+    """The arm's calls (operation, request ms, return id), each answered 1 ms later; the
+    simulated time is the recording's wall time."""
+    calls = [Call(f"/arm/{name}", "pkg/srv/S", None, t * MS, answered(id_), (t + 1) * MS)
+             for name, t, id_ in calls_ms]
+    clock = ClockMap()
+    for t in range(0, 5000, 10):
+        clock.add(t * MS, t * MS)
+    return Plan(calls, [], lambda c: c.service.rsplit("/", 1)[0], {}, clock)
+
+
+def arm_moving(*spans_ms: tuple[int, int]) -> SpeedTrack:
+    """30 degree/s within the spans, at rest elsewhere: samples every 20 ms to 4 s."""
+    track = SpeedTrack()
+    for t in range(0, 4000, 20):
+        track.add(t * MS, 30.0 if any(a <= t < b for a, b in spans_ms) else 0.0)
+    return track
+
+
+def allowed_after(plan: Plan, track: SpeedTrack, errors: list[float]) -> list[float]:
+    return plan.allowances(errors, lambda d, t0, t1: track.peak(t0, t1), 0.004,
+                           arrivals={"/arm": plan.arrivals("/arm", track, 1.0)})
+
+
+def test_an_arrival_at_an_absolute_place_ends_the_drift_of_its_device():
+    # a move, a pause 20 ms late, resume, a move to an absolute place queued behind; it ends
+    # at 2000 ms; a read while it arrives (the replay's device may be 36 ms late), one after
+    plan = arm_plan(("move_ptp_joint_rel", 0, 0), ("pause", 300, 0), ("resume", 500, 0),
+                    ("move_ptp_joint_abs", 600, 0), ("get_feedback_pos_joint", 2010, 0),
+                    ("get_state", 2200, 0), ("get_feedback_pos_joint", 2500, 0))
+    track = arm_moving((0, 300), (500, 2000))
+    assert plan.commanding == [True] * 4 + [False] * 3
+    assert plan.absolute == [False, False, False, True, False, False, False]
+    assert plan.arrivals("/arm", track, 1.0) == [2000 * MS]
+    errors = [0.0, 0.020, 0.0, 0.0, 0.0, 0.0, 0.0]
+    allowed = allowed_after(plan, track, errors)
+    before = allowed[3]
+    assert before == pytest.approx(30 * (0.004 + 0.024 + 0.004 + 0.004))
+    assert allowed[4] > before                   # within the 36 ms it may take to arrive
+    # arrived in both runs: what the timing left is gone, and at rest a read's own timing
+    # moves nothing
+    assert allowed[5] == allowed[6] == 0.0
+    # without the arrivals: the drift is carried on for good
+    carried = plan.allowances(errors, lambda d, t0, t1: track.peak(t0, t1), 0.004)
+    assert carried[6] > before
+
+
+@pytest.mark.parametrize("calls, moving", [
+    # refused: the arm is where the move before left it
+    ((("move_ptp_joint_rel", 0, 0), ("move_ptp_joint_abs", 100, -3)), ((0, 1000),)),
+    # a stop before it arrived: somewhere on the way
+    ((("move_ptp_joint_abs", 0, 0), ("stop", 800, 0)), ((0, 1000),)),
+    # a move given before the replay's device surely arrived (1000 ms + its timing errors)
+    ((("move_ptp_joint_abs", 0, 0), ("move_ptp_joint_rel", 1005, 0)), ((0, 1000), (1020, 1500))),
+    # a relative move queued behind it: the rest is that move's end
+    ((("move_ptp_joint_abs", 0, 0), ("move_ptp_joint_rel", 100, 0)), ((0, 1000), (1020, 1500))),
+])
+def test_no_arrival_ends_the_drift_unless_the_device_surely_is_at_the_absolute_place(calls, moving):
+    plan = arm_plan(*calls, ("get_feedback_pos_joint", 3000, 0))
+    track = arm_moving(*moving)
+    errors = [0.030] * len(calls) + [0.0]
+    allowed = allowed_after(plan, track, errors)
+    carried = plan.allowances(errors, lambda d, t0, t1: track.peak(t0, t1), 0.004)
+    assert allowed == carried

@@ -298,8 +298,9 @@ class RequestReplay:
                                                   job_ns, self.job_clock, MOVING)
                      for device, track in speeds.items()}
         margin_s = self.clock.period_ns() / 1e9
+        arrivals = {device: plan.arrivals(device, track, MOVING) for device, track in speeds.items()}
         allowed = plan.allowances(errors, lambda device, t0, t1: speeds[device].peak(t0, t1)
-                                  if device in speeds else 0.0, margin_s, reactions)
+                                  if device in speeds else 0.0, margin_s, reactions, arrivals)
         for k in range(len(self.calls)):
             n = plan.input_of[k]
             self._compare(k, answers.get(k), allowed[n], errors[n])
