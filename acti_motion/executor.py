@@ -162,15 +162,8 @@ class Device:
     def submit(self, plan: Callable[[Any], Motion], label: str) -> int | None:
         """Plan a motion from the end of the last queued one and append it; its id, or None when
         the queue is full (`submit_all` of one)."""
-        got = self.submit_doomed(plan, label)
-        return None if got is None else got[0]
-
-    def submit_doomed(self, plan: Callable[[Any], Motion],
-                      label: str) -> tuple[int, str | None] | None:
-        """`submit`, with `doomed(id)` read under the hold of the lock that queued it (a move's
-        accept takes the lock once less); None when the queue is full."""
-        got = self._submit_all([(plan, label)])
-        return None if got is None else (got[0][0], got[1])
+        got = self.submit_doomed([(plan, label)])
+        return None if got is None else got[0][0]
 
     def submit_all(self, plans: Sequence[tuple[Callable[[Any], Motion], str]]) -> list[int] | None:
         """Plan motions one after the other, each from the end of the one before (the first from
@@ -186,12 +179,13 @@ class Device:
         says so, and nothing of them runs. They arrive when this is called: planned, or waiting
         for another's plan, across the end of a stop, they were queued after it and ran.
         """
-        got = self._submit_all(plans)
+        got = self.submit_doomed(plans)
         return None if got is None else got[0]
 
-    def _submit_all(self, plans: Sequence[tuple[Callable[[Any], Motion], str]]
-                    ) -> tuple[list[int], str | None] | None:
-        """`submit_all`'s ids with why the last is doomed (`doomed`), read in the same hold."""
+    def submit_doomed(self, plans: Sequence[tuple[Callable[[Any], Motion], str]]
+                      ) -> tuple[list[int], str | None] | None:
+        """`submit_all`'s ids with why the last is doomed (`doomed`), read in the same hold
+        (a move's accept takes the lock once less); None when the queue is full."""
         arrived = None          # nobody else plans: it arrives in the hold that reads the queue
         if not self._accept.acquire(blocking=False):
             arrived = self.arrival()                # it arrives now, before it waits its turn
@@ -206,12 +200,13 @@ class Device:
                     generation, start = self.generation, self.queued_end
                 motions = []
                 for plan, _ in plans:
+                    if motions:                     # from the end of the one before
+                        start = motions[-1].at(motions[-1].duration)
                     motions.append(plan(start))
-                    start = motions[-1].at(motions[-1].duration)
                 with self.lock:
                     if len(self.queue) + len(plans) > self.capacity:
                         return None
-                    if generation != self.generation or self.stopped_since(arrived):
+                    if generation != self.generation or self._stops != arrived:  # `stopped_since`
                         if self.current is None and not self.queue:
                             ids = [self._accept_discarded() for _ in plans]
                             return ids, self._doomed(ids[-1]) if ids else None
@@ -234,7 +229,9 @@ class Device:
                         # motion over at once is none: an idle loop woken for it stepped the
                         # steps it slept over while the answer went out
                         self.wake()
-                    return ids, self._doomed(ids[-1]) if ids else None
+                    # ids given now, none discarded yet: doomed only by a stop decelerating
+                    # (`_doomed`; a device at rest has none, and a motion over at once rests it)
+                    return ids, self._reason if ids and self._stop_at is not None else None
         finally:
             self._accept.release()
 

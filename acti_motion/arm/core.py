@@ -26,6 +26,7 @@ from typing import Callable
 import numpy as np
 
 from acti_motion.arm.kinematics import ArmKinematics
+from acti_motion.arm.limits import SoftLimits
 from acti_motion.arm.planning import MovePlanning
 from acti_motion.arm.poses import Frames, compose_relative, hg_as_set, pose_to_hg
 from acti_motion.arm.settings import (BASE_OFFSET_MM, CONTROL_POINT_OFFSET_MM, MAX_ACCEL_TIME_S,
@@ -94,7 +95,11 @@ class ArmCore(SoftLimitWatch, MovePlanning):
         self.finger_max = world.limits[GRIPPER_JOINTS[0]].upper
         # settings (units of the ports)
         self.max_speed_joint = self.hard_max_speed_joint.copy()
-        self.soft_limit_joint = self.hard_limit_joint.copy()          # rows: [lower, upper]
+        # rows (lower, upper): the joints' hardware range, the widest box (the config's is set
+        # by `_apply_settings`, through its setter's checks)
+        widest = [[-SOFT_LIMIT_CARTESIAN_MM, SOFT_LIMIT_CARTESIAN_MM]] * 3
+        self.limits = SoftLimits(self.hard_limit_joint.copy(), np.array(widest),
+                                 self.hard_limit_joint)
         self.speed_joint = ratio_percent(c.initial_speed_ratio, "initial_speed_ratio")
         self.speed_cartesian = self.speed_joint
         self.min_accel_time_joint = self.accel_time_joint = MAX_ACCEL_TIME_S
@@ -119,6 +124,24 @@ class ArmCore(SoftLimitWatch, MovePlanning):
         self._reach_memo = None                       # the reach's ball in the robot frame
         self._limits_memo = None                      # a CP move's limits at its settings
         executor.after_step(self._sample)
+
+    @property
+    def soft_limit_joint(self) -> np.ndarray:
+        """The joint soft limits (degree), rows (lower, upper); setting them makes `limits` anew."""
+        return self.limits.joint
+
+    @soft_limit_joint.setter
+    def soft_limit_joint(self, rows: np.ndarray) -> None:
+        self.limits = self.limits.with_joint(rows)
+
+    @property
+    def soft_limit_cartesian(self) -> np.ndarray:
+        """The Cartesian soft limits (mm), rows (lower, upper): x, y, z (as `soft_limit_joint`)."""
+        return self.limits.cartesian
+
+    @soft_limit_cartesian.setter
+    def soft_limit_cartesian(self, rows: np.ndarray) -> None:
+        self.limits = self.limits.with_cartesian(rows)
 
     def _apply_settings(self, c: ArmConfig) -> None:
         """The start-up settings that a service also sets, through that service's validation
@@ -372,9 +395,9 @@ class ArmCore(SoftLimitWatch, MovePlanning):
 
     @returns(*SETTER)
     def set_home(self, joint_point: list[float]) -> None:
-        q = finite_vector(joint_point, self.axis_count, "joint_point")
-        self._check_joint_target(q, "joint_point")
-        self.home = q
+        q = finite_floats(joint_point, self.axis_count, "joint_point")
+        self.limits.check_target(q, "joint_point")
+        self.home = np.array(q)
 
     # === middle-level port: motion control ======================================================
     @returns(*CONTROL)
@@ -421,11 +444,9 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     def move_ptp_joint_rel(self, joint_points: list[float]) -> dict:
         self._check_can_move(self.speed_joint, "set_speed_joint")
         step = finite_floats(joint_points, self.axis_count, "joint_points")
-        self._check_joint_step(step, "joint_points")
-        delta = list(map(math.radians, step))
-        return self.queue_joint_move(
-            lambda start: [a + d for a, d in zip(self.joint_floats(start.joints), delta)],
-            "move_ptp_joint_rel")
+        self.limits.check_step(step, "joint_points")
+        return self.queue_joint_move(None, "move_ptp_joint_rel",
+                                     step=list(map(math.radians, step)))
 
     @returns(*MOVE)
     @plans
@@ -436,7 +457,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
     def _queue_joint_target(self, goal_deg: np.ndarray, label: str) -> dict:
         """A PTP move to an absolute target (degree), checked against the soft limits before
         the queue is looked at: a full queue would have hidden that it is wrong from any start."""
-        self._check_joint_target(goal_deg, label)
+        self.limits.check_target(goal_deg.tolist(), label)
         goal = np.radians(goal_deg)
         return self.queue_joint_move(lambda start: goal, label)
 

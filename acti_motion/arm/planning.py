@@ -15,11 +15,13 @@ import math
 import operator
 import threading
 from contextlib import contextmanager
-from typing import Any, Callable, Iterator
+from functools import partial
+from typing import Callable, Iterator
 
 import numpy as np
 
 from acti_motion.arm.kinematics import FEW_POSTURES, ArmKinematics, Unreachable, rotate_about
+from acti_motion.arm.limits import NEAR_LIMIT_DEG, SoftLimits
 from acti_motion.arm.poses import Frames
 from acti_motion.arm.trajectories import (ArmMotion, ArmSetpoint, CartesianLimits,
                                           CartesianPath, CartesianPlanner, LinearJointPath,
@@ -34,8 +36,6 @@ REL_ELBOW_CLEARANCE = math.sin(math.radians(10.0))
 REACH_SAMPLES = 64                       # points of a CP path checked against the reach first
 MAX_CHECK_SAMPLES = 20000                # points of a CP path checked against the soft limits
 NEAR_LIMIT_MM = 1.0      # samples this close to a Cartesian soft limit: checked between, finer
-NEAR_LIMIT_DEG = 0.01    # the same for a joint soft limit along a CP path's joint spline
-_NEAR_JOINT_LIMIT = np.array([NEAR_LIMIT_DEG, -NEAR_LIMIT_DEG])
 
 
 def _near_limits_refined(ss: np.ndarray, values: np.ndarray, evaluate: Callable[[np.ndarray], np.ndarray],
@@ -68,13 +68,6 @@ def _well_inside(values: np.ndarray | list[list[float]], bounds: np.ndarray | li
     rows = values.tolist() if isinstance(values, np.ndarray) else values
     return all(all(map(operator.lt, lower, row)) and all(map(operator.lt, row, upper))
                for row in rows)
-
-
-def _clear_of_joint_limits(lj: np.ndarray, lc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(lower, upper) (rad) of the joints NEAR_LIMIT_DEG inside their soft limits `lj` (degree,
-    rows: joints): what a CP spline's bound keeps clear of (`lc` unused)."""
-    clear = np.radians(lj + _NEAR_JOINT_LIMIT)
-    return clear[:, 0], clear[:, 1]
 
 
 def _position_mm(pose: np.ndarray) -> list[float]:
@@ -123,8 +116,7 @@ class MovePlanning:
     planner: CartesianPlanner
     _batch: threading.local               # the moves an `all_or_nothing` collects
     _check_can_move: Callable[..., None]
-    _limit_rows: Callable[[], np.ndarray]
-    _for_limits: Callable[..., Any]
+    limits: SoftLimits                    # the soft limits in force (made anew when one is set)
     _posture_memo: tuple[Frames, list[float], list[float]] | None   # (frames, joints, position)
     _joints_memo: tuple[np.ndarray, list[float]] | None             # (set-point joints, floats)
     _speeds_memo: tuple[np.ndarray, float, list[float]] | None      # (rated, ratio, speeds)
@@ -132,31 +124,6 @@ class MovePlanning:
     _limits_memo: tuple[np.ndarray, tuple, CartesianLimits] | None  # (rated, settings, limits)
 
     # === checks ======================================================================================
-    def _limit_floats(self) -> tuple[list[list[float]], list[list[float]], list[list[float]]]:
-        """The rows (lower, upper) of the joint soft limits (degree), the Cartesian soft limits
-        (mm) and the joints' hardware range (degree) as plain floats, made again only when a
-        limit was set: a PTP accept reads each (a numpy call apiece, 1 … 3 µs on a cold core)."""
-        return self._for_limits("_floats_made", lambda lj, lc: (
-            lj.tolist(), lc.tolist(), self.hard_limit_joint.tolist()))
-
-    def _check_joint_target(self, goal_deg: np.ndarray | list[float], name: str) -> None:
-        for i, (q, (a, b)) in enumerate(zip(floats(goal_deg), self._limit_floats()[0])):
-            if not a - 1e-9 <= q <= b + 1e-9:
-                raise value_error(f"{name}: J{i + 1} = {q:.10g}° is outside the soft limit "
-                                  f"[{a:g}, {b:g}]°")
-
-    def _check_joint_step(self, step_deg: np.ndarray | list[float], name: str) -> None:
-        """A relative step that takes no start within the hardware range into the soft limits
-        is VALUE_ERR before the queue is looked at (a full queue would have hidden it). Only
-        that: the arm may rest outside soft limits set since, and a step back in is a move.
-        (Plain floats: on a cold core each numpy call of a PTP accept cost 10-25 µs.)"""
-        soft, _, hard = self._limit_floats()
-        for i, (d, (slo, shi), (hlo, hhi)) in enumerate(zip(floats(step_deg), soft, hard)):
-            if not slo - hhi - 1e-9 <= d <= shi - hlo + 1e-9:
-                raise value_error(f"{name}: J{i + 1} by {d:g}° leaves the soft limit "
-                                  f"[{slo:g}, {shi:g}]° from any start within its "
-                                  f"range [{hlo:g}, {hhi:g}]°")
-
     def _check_target(self, target: np.ndarray, label: str, frames: Frames | None = None,
                       psi: float | None = None) -> None:
         """A target (4×4, m) within the Cartesian soft limit and the arm's reach and, given its
@@ -233,7 +200,7 @@ class MovePlanning:
         each piece keeps it clear of them (as the samples would find), else at 4 samples per
         IK sample, finer near a limit."""
         lim = self.soft_limit_joint
-        if spline_within(spline, *self._for_limits("_clear_made", _clear_of_joint_limits)):
+        if spline_within(spline, *self.limits.clear):
             return
         dense = np.linspace(0.0, 1.0, 4 * len(spline.ss))
 
@@ -243,42 +210,56 @@ class MovePlanning:
             dense, joints_deg(dense), joints_deg, lim[:, 0], lim[:, 1], NEAR_LIMIT_DEG), label)
 
     # === queueing ======================================================================================
-    def queue_joint_move(self, goal_of: Callable[[ArmSetpoint], np.ndarray | list[float]],
+    def queue_joint_move(self, goal_of: Callable[[ArmSetpoint], np.ndarray | list[float]] | None,
                          label: str, speed_ratio: float | None = None,
-                         ramp: float | None = None) -> dict:
-        """A PTP move to goal_of(start) (rad): synchronized trapezoid at the joint speed ratio
-        and accel time (or the given ones: STROLIC programs keep their own). The 7 joints'
-        arithmetic is in plain floats (numpy's calls cost 1 … 3 µs each on a cold core)."""
+                         ramp: float | None = None, *, step: list[float] | None = None) -> dict:
+        """A PTP move to goal_of(start) (rad), or by `step` (rad) from the start (goal_of None):
+        synchronized trapezoid at the joint speed ratio and accel time (or the given ones:
+        STROLIC programs keep their own)."""
         speed = self._joint_speeds(self.speed_joint if speed_ratio is None else speed_ratio)
         ramp = self.accel_time_joint if ramp is None else ramp
+        return self._submit(partial(self._plan_joint_move, goal_of, step, label, speed, ramp),
+                            label)
 
-        def plan(start: ArmSetpoint) -> ArmMotion:
-            frames = self.frames          # read while planning: the offsets wait for it
-            goal = floats(goal_of(start))
-            self._check_joint_target(list(map(math.degrees, goal)), label)
-            q0 = self.joint_floats(start.joints)
-            delta = [g - a for g, a in zip(goal, q0)]
-            end = [a + d for a, d in zip(q0, delta)]
-            path = LinearJointPath.from_floats(start.joints, delta, end)
-            self._joints_memo = (path.end, end)     # where the next move starts
-            steps = 1 + max(1, math.ceil(math.degrees(max(map(abs, delta)))))
+    def _plan_joint_move(self, goal_of: Callable[[ArmSetpoint], np.ndarray | list[float]] | None,
+                         step: list[float] | None, label: str, speed: list[float], ramp: float,
+                         start: ArmSetpoint) -> ArmMotion:
+        """`queue_joint_move`'s plan from `start`. The 7 joints' arithmetic is in plain floats,
+        with the few Python calls it can (numpy's calls cost 1 … 3 µs each on the cold core of
+        an accept, a Python call ~0.5 µs)."""
+        frames = self.frames          # read while planning: the offsets wait for it
+        q0 = self.joint_floats(start.joints)
+        goal = list(map(operator.add, q0, step)) if goal_of is None else floats(goal_of(start))
+        self.limits.check_target(list(map(math.degrees, goal)), label)
+        delta = list(map(operator.sub, goal, q0))
+        end = list(map(operator.add, q0, delta))
+        path = LinearJointPath.from_floats(start.joints, delta, end)
+        self._joints_memo = (path.end, end)     # where the next move starts
+        if not self._line_near_kept_posture_inside(frames, q0, end):
+            self._check_joint_line(frames, q0, delta, label)
+        timing = Trapezoid.for_axes(delta, speed, ramp)
+        return ArmMotion(path, timing, start.finger, start.finger, ramp, "joint")
 
-            def position_at(q: list[float]) -> list[float]:
-                return self._position_at(frames, q)
+    def _check_joint_line(self, frames: Frames, q0: list[float], delta: list[float],
+                          label: str) -> None:
+        """The control point along the joint line q0 + s·delta (rad) within the Cartesian soft
+        limit, at every degree of the longest joint's way and finer near a limit, else
+        VALUE_ERR."""
+        steps = 1 + max(1, math.ceil(math.degrees(max(map(abs, delta)))))
 
-            def positions_mm(ss: np.ndarray | list[float]) -> np.ndarray:
-                return np.asarray(_line_positions_mm(self.kin, frames, q0, delta, ss, position_at))
-            ss = [k / (steps - 1) for k in range(steps)]   # every degree of the longest joint's way
-            lim = self.soft_limit_cartesian
-            if not self._line_near_kept_posture_inside(frames, q0, end):
-                positions = _line_positions_mm(self.kin, frames, q0, delta, ss, position_at)
-                if not _well_inside(positions, self._limit_floats()[1], NEAR_LIMIT_MM):
-                    self._check_cartesian_positions(_near_limits_refined(
-                        np.array(ss), np.asarray(positions), positions_mm, lim[:, 0], lim[:, 1],
-                        NEAR_LIMIT_MM), label)
-            timing = Trapezoid.for_axes(delta, speed, ramp)
-            return ArmMotion(path, timing, start.finger, start.finger, ramp, "joint")
-        return self._submit(plan, label)
+        def position_at(q: list[float]) -> list[float]:
+            return self._position_at(frames, q)
+
+        def positions_mm(ss: np.ndarray | list[float]) -> np.ndarray:
+            return np.asarray(_line_positions_mm(self.kin, frames, q0, delta, ss, position_at))
+        ss = [k / (steps - 1) for k in range(steps)]
+        positions = _line_positions_mm(self.kin, frames, q0, delta, ss, position_at)
+        limits = self.limits
+        if not _well_inside(positions, limits.cartesian_floats, NEAR_LIMIT_MM):
+            lim = limits.cartesian
+            self._check_cartesian_positions(_near_limits_refined(
+                np.array(ss), np.asarray(positions), positions_mm, lim[:, 0], lim[:, 1],
+                NEAR_LIMIT_MM), label)
 
     def _joint_speeds(self, ratio: float) -> list[float]:
         """The joints' speeds (rad/s) at `ratio` %, made again only when the ratio or the rated
@@ -318,8 +299,7 @@ class MovePlanning:
         far = max(sum(map(abs, map(operator.sub, q0, kept))),
                   sum(map(abs, map(operator.sub, end, kept))))
         clear = far * self.planner.reach_radius(frames) * 1000.0 + NEAR_LIMIT_MM + 1e-6
-        box = self._limit_floats()[1]
-        return all(lo + clear < p < hi - clear for p, (lo, hi) in zip(position, box))
+        return self.limits.box_clear(position, clear)
 
     def _position_at(self, frames: Frames, q: list[float]) -> list[float]:
         """The control point (mm) of posture q (rad) in `frames`; the last one computed is kept:
@@ -439,15 +419,15 @@ class MovePlanning:
 
     def _submit(self, plan: Callable[[ArmSetpoint], ArmMotion], label: str) -> dict | Reply:
         """Queue one planned move; inside `all_or_nothing` (on this thread), collect it."""
-        guarded = self._guarded(plan, label)
+        guarded = partial(self._guarded_plan, plan, label)
         collected = getattr(self._batch, "plans", None)
         if collected is not None:
             collected.append((guarded, label))
             return {"motion_id": 0}
-        got = self.device.submit_doomed(guarded, label)
+        got = self.device.submit_doomed([(guarded, label)])
         if got is None:
             raise self._full()
-        motion_id, why = got
+        (motion_id,), why = got
         if why is not None:         # OK as 5.4.19 has it, and said: its wait will say the same
             return Reply(R.OK, f"discarded: {why} (a stop discards every command given until "
                                "the arm is at rest)", {"motion_id": motion_id})
@@ -476,26 +456,25 @@ class MovePlanning:
         return Refused(R.FULL_MOTION_QUEUE_ERR,
                        f"the motion queue is full ({self.device.capacity} motions): wait or stop")
 
-    def _guarded(self, plan: Callable[[ArmSetpoint], ArmMotion],
-                 label: str) -> Callable[[ArmSetpoint], ArmMotion]:
-        def guarded(start: ArmSetpoint) -> ArmMotion:
-            """A refusal passes; any other failure of planning is this request's NG, said. The
-            servo and alarms are checked again here, after the device took its generation: a
-            servo_off (or an alarm) that came while this request waited for another's plan
-            stopped an idle arm, and the move would have been queued behind it."""
-            self._check_can_move()
-            limits = self._limit_rows()
-            try:
-                motion = plan(start)
-            except Refused:
-                raise
-            except Unreachable as e:
-                raise value_error(f"{label}: {e}") from None
-            except Exception as e:
-                raise Refused(R.NG, f"{label} could not be planned: {type(e).__name__}: {e}") \
-                    from None
-            if not math.isfinite(motion.duration):
-                raise value_error(f"{label}: the move would take forever at these settings")
-            motion.limits_checked = limits
-            return motion
-        return guarded
+    def _guarded_plan(self, plan: Callable[[ArmSetpoint], ArmMotion], label: str,
+                      start: ArmSetpoint) -> ArmMotion:
+        """plan(start), as the device calls it: a refusal passes; any other failure of planning
+        is this request's NG, said. The servo and alarms are checked again here, after the
+        device took its generation: a servo_off (or an alarm) that came while this request
+        waited for another's plan stopped an idle arm, and the move would have been queued
+        behind it."""
+        self._check_can_move()
+        limits = self.limits.rows
+        try:
+            motion = plan(start)
+        except Refused:
+            raise
+        except Unreachable as e:
+            raise value_error(f"{label}: {e}") from None
+        except Exception as e:
+            raise Refused(R.NG, f"{label} could not be planned: {type(e).__name__}: {e}") \
+                from None
+        if not math.isfinite(motion.duration):
+            raise value_error(f"{label}: the move would take forever at these settings")
+        motion.limits_checked = limits
+        return motion

@@ -12,18 +12,17 @@ from __future__ import annotations
 import threading
 from dataclasses import dataclass
 from enum import IntEnum
-from typing import Any, Callable
+from typing import Callable
 
 import numpy as np
 
+from acti_motion.arm.limits import SoftLimits
 from acti_motion.executor import MotionExecutor
 from acti_sim.world import World
 
 ALARM_JOINT_SOFT_LIMIT = 0x4
 ALARM_CARTESIAN_SOFT_LIMIT = 0x5
 
-CARTESIAN_WATCH_TOLERANCE_MM = 0.1
-JOINT_WATCH_TOLERANCE_DEG = 1e-6
 # Joints measured faster than this still move (the state word's 0x02): a stop's tail decays from
 # ~0.3°/s to this in ~5 control periods; the base driving shakes the arm's joints by < 0.004°/s.
 SETTLED_DEG_S = 0.05
@@ -54,6 +53,7 @@ class SoftLimitWatch:
 
     _alarms: list[Alarm]
     _alarm_lock: threading.Lock
+    limits: SoftLimits                    # the soft limits in force
     _inside: np.ndarray | None            # which limit rows the last set-point was within
     _settling: bool                       # the measured joints still move (SETTLED_DEG_S)
     stop_motion: Callable[..., None]
@@ -100,7 +100,7 @@ class SoftLimitWatch:
         if not inside.all():
             checked = getattr(cur.motion, "limits_checked", None)
             changed = (np.ones(len(inside), bool) if checked is None
-                       else np.any(checked != self._limit_rows(), axis=1))
+                       else np.any(checked != self.limits.rows, axis=1))
             left = np.flatnonzero(~inside & (was | changed))
             if len(left):
                 alarm = self._limit_alarm(int(left[0]), values, "exceeded")
@@ -118,7 +118,7 @@ class SoftLimitWatch:
         t_rest = d.rest_time_after_next_step(fastest, self.executor.dt)
         if t_rest <= d.t:
             return                                   # held at rest (paused, stopped)
-        lower, upper = self._limit_rows().T
+        lower, upper = self.limits.rows.T
         within_now = (values >= lower) & (values <= upper)
         if not within_now.any():
             return
@@ -175,29 +175,9 @@ class SoftLimitWatch:
             self._alarms.append(alarm)
         return f"alarm 0x{alarm.code:X} ({alarm.description})"
 
-    def _limit_rows(self) -> np.ndarray:
-        """The soft limits as rows (lower, upper): J1 … J7 (degree), then x, y, z (mm); read-only,
-        made again only when a limit was set (`_for_limits`): every accept and every moving
-        step reads them."""
-        def rows(lj: np.ndarray, lc: np.ndarray) -> np.ndarray:
-            made = np.concatenate([lj, lc])
-            made.flags.writeable = False
-            return made
-        return self._for_limits("_rows_made", rows)
-
-    def _for_limits(self, name: str, build: Callable[[np.ndarray, np.ndarray], Any]) -> Any:
-        """build(joint soft limits, Cartesian soft limits), kept as attribute `name` and made
-        again only when a limit was set (each setter assigns new arrays)."""
-        lj, lc = self.soft_limit_joint, self.soft_limit_cartesian
-        made = getattr(self, name, None)
-        if made is None or made[0] is not lj or made[1] is not lc:
-            made = (lj, lc, build(lj, lc))
-            setattr(self, name, made)
-        return made[2]
-
     def _watched_values(self, q: np.ndarray) -> np.ndarray:
         """Joint values (degree) and control-point position (mm) of set-point q: the rows of
-        `_limit_rows`."""
+        `limits.rows`."""
         p = self.frames.tool_of(self.kin.flange(q))[:3, 3] * 1000.0
         return np.concatenate([np.degrees(q), p])
 
@@ -205,15 +185,5 @@ class SoftLimitWatch:
         """The watched values of set-point q, and which of them lie within the soft limits
         widened by the watch tolerances."""
         values = self._watched_values(q)
-        lower, upper = self._watch_bounds()
+        lower, upper = self.limits.watch_bounds
         return values, (values >= lower) & (values <= upper)
-
-    def _watch_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """The soft limits widened by the watch tolerances (lower, upper), made again only when
-        a limit was set (`_for_limits`): the watch runs every moving step."""
-        def bounds(lj: np.ndarray, lc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            return (np.concatenate([lj[:, 0] - JOINT_WATCH_TOLERANCE_DEG,
-                                    lc[:, 0] - CARTESIAN_WATCH_TOLERANCE_MM]),
-                    np.concatenate([lj[:, 1] + JOINT_WATCH_TOLERANCE_DEG,
-                                    lc[:, 1] + CARTESIAN_WATCH_TOLERANCE_MM]))
-        return self._for_limits("_bounds_made", bounds)

@@ -147,7 +147,7 @@ class ArmTrajectories:
         def plan(seen: tuple) -> Callable[[Device], object]:
             cur, t, start, now = seen
             poly = self.plan(plan_of, start, now)
-            limits = core._limit_rows()
+            limits = core.limits.rows
 
             def commit(device: Device) -> object:
                 if device.current is not cur or self.running() is not cur.motion \
