@@ -88,10 +88,12 @@ $(DEPS_STAMP): $(BUILD_DEPS_STAMP) requirements.txt
 	$(call install_from_wheelhouse,requirements.txt)
 	touch $@
 
-# Python sources need no rebuild: --symlink-install runs them from the tree. Our tf2_msgs
+# Python sources need no rebuild: --symlink-install runs them from the tree (its `setup.py
+# develop` compiles the C extension in place: acti_bringup/serving/_respond.c). Our tf2_msgs
 # (msg_defs/tf2_msgs) and control_msgs (msg_defs/control_msgs) are added only where none is
 # installed (tools/own_msgs.py).
-$(BUILD_STAMP): $(BUILD_DEPS_STAMP) $(INTERFACES) package.xml setup.py setup.cfg tools/own_msgs.py
+$(BUILD_STAMP): $(BUILD_DEPS_STAMP) $(INTERFACES) package.xml setup.py setup.cfg tools/own_msgs.py \
+  $(wildcard acti_bringup/serving/*.c)
 	$(ENV) && $(BUILD_ENV) colcon --log-base log build $(COLCON_PATHS) $$(python tools/own_msgs.py) \
 	  --symlink-install --parallel-workers $(NPROC) --cmake-args $(CMAKE_ARGS)
 	touch $@

@@ -1,7 +1,7 @@
 """ament_python package acti_ros2: the nodes and their ROS-free cores."""
 from glob import glob
 
-from setuptools import find_packages, setup
+from setuptools import Extension, find_packages, setup
 
 PACKAGE = "acti_ros2"
 
@@ -12,6 +12,8 @@ setup(
                                     "acti_motion*", "acti_sim*", "acti_view*", "strolic*",
                                     "roboline*", "acti_record*"]),
     package_data={"roboline": ["grammar.lark"]},
+    # built in place by colcon's `setup.py develop` (make setup): acti_bringup.serving.unlocked
+    ext_modules=[Extension("acti_bringup.serving._respond", ["acti_bringup/serving/_respond.c"])],
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),

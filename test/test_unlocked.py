@@ -18,7 +18,7 @@ from std_srvs.srv import Trigger
 
 from acti_bringup.serving.outbox import Outbox, unlocked_publish
 from acti_bringup.serving.responses import LateResponses, UnlockedSender
-from acti_bringup.serving.unlocked import header_address, rcl
+from acti_bringup.serving.unlocked import header_address, rcl, respond
 from ros_harness import wait_until
 
 
@@ -80,6 +80,12 @@ def test_rcl_is_found_where_rclpy_loaded_it():
     assert rcl() is not None
 
 
+def test_the_one_call_send_is_built():
+    """`make setup` compiles acti_bringup/serving/_respond.c (setup.py's extension, built in
+    place); without it every response would leave through the outbox."""
+    assert respond is not None, "the C extension is not built: run `make setup`"
+
+
 def test_responses_reach_the_client_through_rcl(ros, events_loop):
     node, loop = events_loop
     outbox, headers = Outbox(print), []
@@ -93,10 +99,8 @@ def test_responses_reach_the_client_through_rcl(ros, events_loop):
 
     def send_response(response, header) -> None:
         headers.append(header_address(header))
-        prepared = sender.prepare(response, header)
-        if prepared.now:            # a client answered before: at once, here
-            prepared.send()
-        else:
+        if sender.answer_now(response, header) is None:     # a new client: through the outbox
+            prepared = sender.prepare(response, header)
             outbox.put(prepared.send, prepared.discard)
     service.send_response = send_response
     loop.start()
@@ -110,12 +114,18 @@ def test_responses_reach_the_client_through_rcl(ros, events_loop):
 
 def test_a_client_answered_once_is_answered_from_the_serving_thread(ros, events_loop):
     """The first response to a client leaves from the outbox (DDS may hold it while it meets the
-    client), the next ones at once from the serving thread (no hand-over to pay); all without
-    the GIL."""
+    client), the next ones at once from the serving thread (no hand-over to pay), in one call of
+    the C extension `make setup` builds; all without the GIL."""
     node, loop = events_loop
     threads: list[str] = []
 
     class Recording(UnlockedSender):
+        def answer_now(self, response, header):
+            answered = super().answer_now(response, header)
+            if answered is not None:
+                threads.append(threading.current_thread().name)
+            return answered
+
         def prepare(self, response, header):
             prepared = super().prepare(response, header)
 

@@ -28,7 +28,7 @@ from rclpy.node import Node
 
 from acti_bringup.serving.outbox import Outbox
 from acti_bringup.serving.unlocked import (GUID_BYTES, CMessage, MessageKind, header_address, rcl,
-                                          request_id)
+                                          request_id, respond, sent)
 
 UNDELIVERED = "failed to send response"     # the start of rclpy's warning on a timeout
 RETRY_AFTER_S = (0.05, 0.2, 0.5, 1.0, 2.0, 4.0)   # each retry may block up to 100 ms in rmw
@@ -63,11 +63,9 @@ def delivered(send: Callable[[Any, Any], None], response: Any, header: Any) -> b
 
 
 class Prepared(NamedTuple):
-    """One response ready to go: send() says whether DDS delivered it; discard() if never sent;
-    `now`: send it on the serving thread (its client was answered before)."""
+    """One response ready to go: send() says whether DDS delivered it; discard() if never sent."""
     send: Callable[[], bool]
     discard: Callable[[], None] = lambda: None
-    now: bool = False
 
 
 class RclpySender:
@@ -76,17 +74,22 @@ class RclpySender:
     def __init__(self, service: Any) -> None:
         self._send = service.send_response
 
-    def prepare(self, response: Any, header: Any, again: bool = False) -> Prepared:
+    def answer_now(self, response: Any, header: Any) -> bool | None:
+        """Nothing is sent at once: every response is prepared."""
+        return None
+
+    def prepare(self, response: Any, header: Any) -> Prepared:
         return Prepared(lambda: delivered(self._send, response, header))
 
 
 class UnlockedSender:
-    """Prepares responses for rcl's send without the GIL (`unlocked`), converted now: to be sent
-    now (on the serving thread) to a client answered before (by its request writer's GUID),
-    through the outbox to a new one. Where the header cannot be read or rcl is not found,
-    rclpy's send (through the outbox). The C message of the last response sent at once is kept:
-    the service callback answers an unchanged reply with the same response object
-    (`acti_bringup.serving.adapter`), which is then not converted again."""
+    """Sends responses through rcl without the GIL (`unlocked`): to a client answered before
+    (by its request writer's GUID) at once, on the serving thread, in one foreign call
+    (`answer_now`); to a new one, converted now, through the outbox (`prepare`). Where the
+    header cannot be read or rcl is not found, rclpy's send (through the outbox). The C message
+    of a response sent twice in a row at once is kept: the service callback answers an
+    unchanged reply with the same response object (`acti_bringup.serving.adapter`), which is
+    then not converted again."""
 
     ANSWERED_KEPT = 4096
 
@@ -96,20 +99,38 @@ class UnlockedSender:
         self._kind = MessageKind(service.srv_type.Response)
         self._answered: set[bytes] = set()
         self._kept: tuple[Any, CMessage] | None = None    # serving thread only
+        self._last: Any = None                             # the response sent last at once
+        lib = rcl()
+        self._functions = None if lib is None else (lib.send_response_address, *self._kind.addresses)
+        self._read_in_c = False    # `respond` reads this service's headers as header_address does
 
-    def prepare(self, response: Any, header: Any, again: bool = False) -> Prepared:
-        """`again`: a response sent again off the serving thread (it never takes the kept C
-        message, which the serving thread frees when it keeps another)."""
+    def answer_now(self, response: Any, header: Any) -> bool | None:
+        """Send `response` here and now when its client was answered before: whether DDS
+        delivered it; None when nothing was sent (a new client, a header not read yet)."""
+        if not self._read_in_c:
+            return None
+        kept = self._kept
+        if kept is not None and kept[0] is response:      # an unchanged reply
+            message = kept[1].address
+        elif response is self._last:                      # sent twice in a row: kept from now on
+            message = self._keep(response).address
+        else:
+            self._kind.check(response)
+            self._last, message = response, 0
+        with self._handle:
+            ret = respond.respond(header, self._answered, self._handle.pointer, self._functions,
+                                  message, response)
+        return None if ret is None else sent(ret)
+
+    def prepare(self, response: Any, header: Any) -> Prepared:
+        """A response to send later, off the serving thread: converted now."""
         lib = rcl()
         address = header_address(header) if lib is not None else None
         if address is None:
             return self._rclpy.prepare(response, header)
+        if not self._read_in_c and respond is not None:
+            self._read_in_c = respond.request_id(header) == address
         client = ctypes.string_at(address, GUID_BYTES)
-        if client in self._answered and not again:  # header and message live until it is sent
-            message = self._converted(response)
-            return Prepared(lambda: message.send(
-                self._handle, lambda s, m: lib.send_response(s, address, m), keep=True),
-                lambda: None, True)
         message = CMessage(self._kind, response)
         copied = request_id(address)
 
@@ -124,17 +145,13 @@ class UnlockedSender:
             return sent
         return Prepared(send, message.discard)
 
-    def _converted(self, response: Any) -> CMessage:
-        """`response`'s C message: the kept one when it is the response sent last, else a new
-        one, kept instead (the old one is freed: its send is over, on this same thread)."""
-        kept = self._kept
-        if kept is not None and kept[0] is response:
-            return kept[1]
-        message = CMessage(self._kind, response)
-        self._kept = (response, message)
-        if kept is not None:
-            kept[1].discard()
-        return message
+    def _keep(self, response: Any) -> CMessage:
+        """A new C message of `response`, kept instead of the one kept before (which is freed:
+        its send is over, on this same thread)."""
+        old, self._kept = self._kept, (response, CMessage(self._kind, response))
+        if old is not None:
+            old[1].discard()
+        return self._kept[1]
 
 
 Sender = Callable[[Any], "RclpySender | UnlockedSender"]
@@ -166,19 +183,19 @@ class LateResponses:
 
     def _responder(self, sender: RclpySender | UnlockedSender,
                    name: str) -> Callable[[Any, Any], None]:
-        """service.send_response: prepare the response here; send it here or on the outbox
-        thread, as prepared."""
+        """service.send_response: sent here to a client answered before, else prepared here
+        and sent on the outbox's thread."""
         def send_response(response: Any, header: Any) -> None:
             try:
-                prepared = sender.prepare(response, header)
+                delivered = sender.answer_now(response, header)
+                if delivered is None:
+                    prepared = sender.prepare(response, header)
+                    self._outbox.put(lambda: self._deliver(prepared, sender, response, header, name),
+                                     prepared.discard)
+                elif not delivered:
+                    self._later(0, sender, response, header, name)
             except Exception as e:   # raised out of the executor, it would end the serving
                 self._log(f"a response to {name} could not be sent: {type(e).__name__}: {e}")
-                return
-            if prepared.now:
-                self._deliver(prepared, sender, response, header, name)
-            else:
-                self._outbox.put(lambda: self._deliver(prepared, sender, response, header, name),
-                                 prepared.discard)
         return send_response
 
     def _deliver(self, prepared: Prepared, sender: Any, response: Any, header: Any,
@@ -203,7 +220,7 @@ class LateResponses:
                     self._wake.wait(None if not self._due else self._due[0][0] - time.monotonic())
                 _, _, attempt, sender, response, header, name = heapq.heappop(self._due)
             try:
-                if sender.prepare(response, header, again=True).send():
+                if sender.prepare(response, header).send():
                     continue
             except Exception as e:   # the service was destroyed, the process ends
                 self._log(f"response to {name} not sent again: {e}")

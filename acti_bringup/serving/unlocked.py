@@ -12,6 +12,9 @@ rclpy gives Python no access to a request header's writer GUID, which rcl needs.
 a pybind11 object whose first slot holds the address of its C `rmw_request_id_t`; that address
 is used only when the sequence number read through it is the one rclpy reports, else (another
 rclpy layout) the response goes through rclpy as before.
+
+A client answered before is answered in one foreign call (`respond`, of the C extension that
+`make setup` builds: acti_bringup/serving/_respond.c), which reads the header the same way.
 """
 from __future__ import annotations
 
@@ -22,11 +25,20 @@ from typing import Any, Callable
 
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 
+try:
+    from acti_bringup.serving import _respond as respond
+except ImportError:          # not built (a checkout before `make setup`): every response goes
+    respond = None           # through the outbox
+
 RCL_RET_OK = 0
 RCL_RET_TIMEOUT = 2
 _SEQUENCE_OFFSET = 16            # rmw_request_id_t: int8_t writer_guid[16]; int64_t sequence_number
 _REQUEST_ID_SIZE = 24
 _VALUE_SLOT = ctypes.sizeof(ctypes.c_ssize_t) + ctypes.sizeof(ctypes.c_void_p)   # after PyObject_HEAD
+_REQUEST_IN_INFO = 16            # rmw_service_info_t: int64_t source_timestamp, received_timestamp;
+                                 # rmw_request_id_t request_id
+if respond is not None:
+    respond.expect(_rclpy.rmw_service_info_t, _VALUE_SLOT, _REQUEST_IN_INFO)
 
 _capsule_pointer = ctypes.pythonapi.PyCapsule_GetPointer
 _capsule_pointer.restype = ctypes.c_void_p
@@ -63,6 +75,7 @@ class Rcl:
             fn.restype, fn.argtypes = ctypes.c_int, (ctypes.c_void_p,) * 3
         self._rcutils.rcutils_get_error_string.restype = _ErrorString
         self._rcutils.rcutils_reset_error.restype = None
+        self.send_response_address = ctypes.cast(self.send_response, ctypes.c_void_p).value
 
     def error(self) -> str:
         """rcl's last error message (and clear it)."""
@@ -78,6 +91,16 @@ def rcl() -> Rcl | None:
         return Rcl()
     except (OSError, AttributeError):
         return None
+
+
+def sent(ret: int) -> bool:
+    """rcl's return code of a send: True when sent, False on a timeout, else RuntimeError."""
+    if ret == RCL_RET_OK:
+        return True
+    reason = rcl().error()
+    if ret == RCL_RET_TIMEOUT:
+        return False
+    raise RuntimeError(f"rcl could not send it ({ret}): {reason}")
 
 
 class CMessage:
@@ -100,12 +123,12 @@ class CMessage:
         finally:
             if not keep:
                 self.discard()
-        if ret == RCL_RET_OK:
-            return True
-        reason = rcl().error()
-        if ret == RCL_RET_TIMEOUT:
-            return False
-        raise RuntimeError(f"rcl could not send it ({ret}): {reason}")
+        return sent(ret)
+
+    @property
+    def address(self) -> int:
+        """The C message's address (0 once freed)."""
+        return self._pointer or 0
 
     def discard(self) -> None:
         """Free the C message (unsent)."""
@@ -120,14 +143,20 @@ class MessageKind:
     def __init__(self, msg_class: type) -> None:
         meta = type(msg_class)
         self.msg_class = msg_class
-        self._create = _CREATE(_capsule_pointer(meta._CREATE_ROS_MESSAGE, None))
-        self.destroy = _DESTROY(_capsule_pointer(meta._DESTROY_ROS_MESSAGE, None))
-        self._convert = _CONVERT(_capsule_pointer(meta._CONVERT_FROM_PY, None))
+        self.addresses = tuple(_capsule_pointer(capsule, None) for capsule in (
+            meta._CREATE_ROS_MESSAGE, meta._CONVERT_FROM_PY, meta._DESTROY_ROS_MESSAGE))
+        self._create, self._convert, self.destroy = (
+            fn_type(address) for fn_type, address in zip((_CREATE, _CONVERT, _DESTROY),
+                                                         self.addresses))
 
-    def convert(self, msg: Any) -> int:
-        """A new C message holding `msg` (TypeError for another type, as rclpy refuses it)."""
+    def check(self, msg: Any) -> None:
+        """TypeError for a message of another type, as rclpy refuses it."""
         if not isinstance(msg, self.msg_class):
             raise TypeError(f"expected a {self.msg_class.__name__}, got a {type(msg).__name__}")
+
+    def convert(self, msg: Any) -> int:
+        """A new C message holding `msg` (`check`ed)."""
+        self.check(msg)
         pointer = self._create()
         if not pointer:
             raise MemoryError(f"no memory for a {self.msg_class.__name__}")
