@@ -228,3 +228,24 @@ def test_a_response_answered_again_reuses_its_kept_c_message(ros, events_loop):
         r = ros.call(SetSpeedJoint, "/spin_loop_test/kept", spd_ratio=ratio)
         assert r.return_id.comment == f"ratio {ratio}"
     outbox.stop()
+
+
+def test_a_known_client_given_a_response_of_another_type_gets_one_log_line(ros, events_loop):
+    """A callback that returns another type to a client answered before: nothing is sent (as
+    rclpy refuses it), one log line says why, and the service goes on answering."""
+    node, loop = events_loop
+    wrong = [False]
+    node.create_service(Trigger, "~/typed",
+                        lambda _q, response: String(data="x") if wrong[0] else response)
+    outbox, log = Outbox(print), []
+    LateResponses(log.append, outbox).serve([node])
+    loop.start()
+    ros.call(Trigger, "/spin_loop_test/typed")                # the client is known from now on
+    wrong[0] = True
+    ros._clients["/spin_loop_test/typed"].call_async(Trigger.Request())     # the same client
+    assert ros.spin_until(lambda: log, 10.0)
+    assert log == ["a response to /spin_loop_test/typed could not be sent: TypeError: expected a "
+                   "Trigger_Response, got a String"]
+    wrong[0] = False
+    ros.call(Trigger, "/spin_loop_test/typed")
+    outbox.stop()
