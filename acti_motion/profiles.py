@@ -26,7 +26,8 @@ class Trapezoid:
         """Profile for axes moving `distance` at no more than `max_speed` each (same units; a
         speed of 0 for an axis that moves takes for ever). Plain floats: for a handful of axes
         numpy's per-call cost was most of a PTP accept's (lists of floats are taken as they are)."""
-        d, v = floats(distance), floats(max_speed)
+        d = distance if isinstance(distance, list) else floats(distance)    # (a PTP's lists:
+        v = max_speed if isinstance(max_speed, list) else floats(max_speed)  # no call)
         if len(v) == 1:
             v = v * len(d)
         if not any(d):

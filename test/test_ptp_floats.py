@@ -120,7 +120,7 @@ def test_the_kept_posture_is_the_next_move_s_start_and_gives_the_same_position(a
     for step in ([0.5] * 7, [3.0, -2.0, 1.0, 0.0, 0.5, -0.25, 7.0]):  # near the box: computed
         assert arm.move_ptp_joint_rel(step).ok
         end = arm.device.queued_end.joints.tolist()
-        kept_frames, joints, position = arm._posture_memo
+        kept_frames, joints, position, _ = arm._posture_memo
         assert kept_frames is frames and joints == end
         assert position == _line_positions_mm(kin, frames, end, [0.0] * 7, [0.0])[0]
     assert arm.move_ptp_joint_rel([-0.01] * 7).ok          # within 1 mm of the kept posture

@@ -8,7 +8,6 @@ Python call, ~0.5 µs on the cold core of an accept), and all are one moment's l
 from __future__ import annotations
 
 import operator
-from itertools import repeat
 
 import numpy as np
 
@@ -93,10 +92,3 @@ class SoftLimits:
                 raise value_error(f"{name}: J{i + 1} by {d:g}° leaves the soft limit "
                                   f"[{slo:g}, {shi:g}]° from any start within its "
                                   f"range [{hlo:g}, {hhi:g}]°")
-
-    def box_clear(self, position_mm: list[float], clear: float) -> bool:
-        """A position (mm) more than `clear` inside every Cartesian soft limit."""
-        return (all(map(operator.lt, map(operator.add, self.box_lower, repeat(clear)),
-                        position_mm))
-                and all(map(operator.lt, position_mm,
-                            map(operator.sub, self.box_upper, repeat(clear)))))

@@ -16,6 +16,7 @@ import operator
 import threading
 from contextlib import contextmanager
 from functools import partial
+from itertools import repeat
 from typing import Callable, Iterator
 
 import numpy as np
@@ -116,9 +117,12 @@ class MovePlanning:
     planner: CartesianPlanner
     _batch: threading.local               # the moves an `all_or_nothing` collects
     _check_can_move: Callable[..., None]
+    servo: bool
+    _alarms: list
     limits: SoftLimits                    # the soft limits in force (made anew when one is set)
-    _posture_memo: tuple[Frames, list[float], list[float]] | None   # (frames, joints, position)
-    _joints_memo: tuple[np.ndarray, list[float]] | None             # (set-point joints, floats)
+    # (frames, joints, position (mm), the reach's radius in these frames (mm))
+    _posture_memo: tuple[Frames, list[float], list[float], float] | None
+    _joints_memo: tuple[np.ndarray, list[float]] | None   # (a PTP plan's end joints, floats)
     _speeds_memo: tuple[np.ndarray, float, list[float]] | None      # (rated, ratio, speeds)
     _reach_memo: tuple[Frames, list[float], float] | None          # (frames, shoulder, radius)
     _limits_memo: tuple[np.ndarray, tuple, CartesianLimits] | None  # (rated, settings, limits)
@@ -228,7 +232,8 @@ class MovePlanning:
         with the few Python calls it can (numpy's calls cost 1 … 3 µs each on the cold core of
         an accept, a Python call ~0.5 µs)."""
         frames = self.frames          # read while planning: the offsets wait for it
-        q0 = self.joint_floats(start.joints)
+        memo = self._joints_memo      # the start's floats: a move starts where the last ended
+        q0 = memo[1] if memo is not None and memo[0] is start.joints else start.joints.tolist()
         goal = list(map(operator.add, q0, step)) if goal_of is None else floats(goal_of(start))
         self.limits.check_target(list(map(math.degrees, goal)), label)
         delta = list(map(operator.sub, goal, q0))
@@ -271,18 +276,6 @@ class MovePlanning:
                                                        for v in rated.tolist()])
         return memo[2]
 
-    def joint_floats(self, joints: np.ndarray) -> list[float]:
-        """joints.tolist(), kept for the last array asked or planned to (a PTP plan keeps its
-        end's, where the next move starts): a move's goal and its line read the start's floats,
-        which took a numpy call each on the cold core of an accept. Set-points are never
-        changed in place."""
-        memo = self._joints_memo
-        if memo is not None and memo[0] is joints:
-            return memo[1]
-        values = joints.tolist()
-        self._joints_memo = (joints, values)
-        return values
-
     def _line_near_kept_posture_inside(self, frames: Frames, q0: list[float],
                                        end: list[float]) -> bool:
         """The joint line q0 → end (rad) keeps the control point more than NEAR_LIMIT_MM inside
@@ -295,11 +288,13 @@ class MovePlanning:
         memo = self._posture_memo
         if memo is None or memo[0] is not frames:
             return False
-        _, kept, position = memo
+        _, kept, position, reach_mm = memo
         far = max(sum(map(abs, map(operator.sub, q0, kept))),
                   sum(map(abs, map(operator.sub, end, kept))))
-        clear = far * self.planner.reach_radius(frames) * 1000.0 + NEAR_LIMIT_MM + 1e-6
-        return self.limits.box_clear(position, clear)
+        clear = repeat(far * reach_mm + NEAR_LIMIT_MM + 1e-6)
+        limits = self.limits
+        return (all(map(operator.lt, map(operator.add, limits.box_lower, clear), position))
+                and all(map(operator.lt, position, map(operator.sub, limits.box_upper, clear))))
 
     def _position_at(self, frames: Frames, q: list[float]) -> list[float]:
         """The control point (mm) of posture q (rad) in `frames`; the last one computed is kept:
@@ -309,7 +304,7 @@ class MovePlanning:
         if memo is not None and memo[0] is frames and memo[1] == q:
             return memo[2]
         position = _position_mm(frames.tool_of(self.kin.flange(np.array(q))))
-        self._posture_memo = (frames, q, position)
+        self._posture_memo = (frames, q, position, self.planner.reach_radius(frames) * 1000.0)
         return position
 
     def _elbow_goal(self, start_q: np.ndarray, flange: np.ndarray, psi: float | None,
@@ -463,7 +458,8 @@ class MovePlanning:
         device took its generation: a servo_off (or an alarm) that came while this request
         waited for another's plan stopped an idle arm, and the move would have been queued
         behind it."""
-        self._check_can_move()
+        if not self.servo or self._alarms:     # (the attributes `_check_can_move` reads)
+            self._check_can_move()
         limits = self.limits.rows
         try:
             motion = plan(start)
