@@ -117,6 +117,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
         self._alarm_lock = threading.Lock()
         self._inside: np.ndarray | None = None
         self._batch = threading.local()               # the moves an `all_or_nothing` collects
+        self._batching: set[int] = set()              # the threads with such a block open
         self._cartesian_memo: tuple | None = None     # (joints sample, frames, its pose)
         self._posture_memo = None                     # a PTP plan's last posture: `_position_at`
         self._joints_memo = None                      # a set-point's joints as floats

@@ -77,17 +77,26 @@ class LinearJointPath:
 
     def __init__(self, q0: np.ndarray, q1: np.ndarray) -> None:
         self.q0 = np.asarray(q0, float)
-        self.delta = np.asarray(q1, float) - self.q0
+        self._delta: np.ndarray | None = np.asarray(q1, float) - self.q0
+        self._delta_floats: list[float] | None = None
         self.end: np.ndarray | None = None      # q(1.0), when made in advance (`from_floats`)
 
     @classmethod
     def from_floats(cls, q0: np.ndarray, delta: list[float], end: list[float]) -> "LinearJointPath":
         """The line from q0 (an array) by `delta`, ending at `end` = q0 + delta in floats (the
-        very values numpy's q(1.0) gives): two numpy calls where the constructor and q(1.0)
-        take six, 1 … 3 µs each on the cold core of a PTP accept."""
+        very values numpy's q(1.0) gives): one numpy call where the constructor and q(1.0)
+        take six, 1 … 3 µs each on the cold core of a PTP accept. Its `delta` array is made
+        when first read: by the run, on the simulation thread, not by the accept."""
         path = cls.__new__(cls)
-        path.q0, path.delta, path.end = q0, np.array(delta), np.array(end)
+        path.q0, path._delta, path._delta_floats, path.end = q0, None, delta, np.array(end)
         return path
+
+    @property
+    def delta(self) -> np.ndarray:
+        delta = self._delta
+        if delta is None:
+            delta = self._delta = np.array(self._delta_floats)
+        return delta
 
     def q(self, s: float) -> np.ndarray:
         if s == 1.0 and self.end is not None:
