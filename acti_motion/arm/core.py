@@ -120,6 +120,7 @@ class ArmCore(SoftLimitWatch, MovePlanning):
         self._batching: set[int] = set()              # the threads with such a block open
         self._cartesian_memo: tuple | None = None     # (joints sample, frames, its pose)
         self._posture_memo = None                     # a PTP plan's last posture: `_position_at`
+        self._depth_memo = None                       # its depth inside the box
         self._joints_memo = None                      # a set-point's joints as floats
         self._speeds_memo = None                      # the joints' speeds at a ratio
         self._reach_memo = None                       # the reach's ball in the robot frame

@@ -16,7 +16,6 @@ import operator
 import threading
 from contextlib import contextmanager
 from functools import partial
-from itertools import repeat
 from typing import Callable, Iterator
 
 import numpy as np
@@ -123,6 +122,8 @@ class MovePlanning:
     limits: SoftLimits                    # the soft limits in force (made anew when one is set)
     # (frames, joints, position (mm), the reach's radius in these frames (mm))
     _posture_memo: tuple[Frames, list[float], list[float], float] | None
+    # (limits, a kept position, its least distance (mm) from the Cartesian soft limits)
+    _depth_memo: tuple[SoftLimits, list[float], float] | None
     _joints_memo: tuple[np.ndarray, list[float]] | None   # (a PTP plan's end joints, floats)
     _speeds_memo: tuple[np.ndarray, float, list[float]] | None      # (rated, ratio, speeds)
     _reach_memo: tuple[Frames, list[float], float] | None          # (frames, shoulder, radius)
@@ -285,17 +286,21 @@ class MovePlanning:
         farther from it than the reach's radius, so a posture q lies within that radius times
         ‖q − q_kept‖₁ of the kept position, and every posture of the line within the larger of
         its ends' (the norm is convex). Where that ball is well inside, so is every sample the
-        line's check takes (the same answer); False sends the line to that check."""
+        line's check takes (the same answer); False sends the line to that check. The kept
+        position's depth inside the box is kept too, per limits in force (`_depth_memo`); the
+        1e-6 mm the ball is widened by covers its rounding."""
         memo = self._posture_memo
         if memo is None or memo[0] is not frames:
             return False
         _, kept, position, reach_mm = memo
+        limits, depth = self.limits, self._depth_memo
+        if depth is None or depth[0] is not limits or depth[1] is not position:
+            depth = self._depth_memo = (limits, position, min(
+                min(map(operator.sub, position, limits.box_lower)),
+                min(map(operator.sub, limits.box_upper, position))))
         far = max(sum(map(abs, map(operator.sub, q0, kept))),
                   sum(map(abs, map(operator.sub, end, kept))))
-        clear = repeat(far * reach_mm + NEAR_LIMIT_MM + 1e-6)
-        limits = self.limits
-        return (all(map(operator.lt, map(operator.add, limits.box_lower, clear), position))
-                and all(map(operator.lt, position, map(operator.sub, limits.box_upper, clear))))
+        return far * reach_mm + NEAR_LIMIT_MM + 1e-6 < depth[2]
 
     def _position_at(self, frames: Frames, q: list[float]) -> list[float]:
         """The control point (mm) of posture q (rad) in `frames`; the last one computed is kept:
