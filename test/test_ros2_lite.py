@@ -160,6 +160,22 @@ def test_the_graph_commands_print_what_the_real_cli_prints_and_hide_the_hidden(v
     assert got["no node"].stderr == "Unable to find node '/no_such_node'\n"
 
 
+def test_a_node_that_left_the_graph_since_it_was_listed_has_no_endpoints(ros):
+    """`action info` and `node info` list the nodes, then ask each for its endpoints: a node
+    gone meanwhile (the suite's clients come and go) made rcl fail and the command print a
+    traceback (CI at f0c27e9). Asked for a node that is not there, rcl fails the same way."""
+    import ros2_graph
+    from rclpy.action.graph import (get_action_client_names_and_types_by_node,
+                                    get_action_server_names_and_types_by_node)
+    node = ros.node
+    for query in (get_action_client_names_and_types_by_node,
+                  get_action_server_names_and_types_by_node):
+        assert ros2_graph.of_node(query, node, "no_such_node", "/") == []
+    for query in (node.get_publisher_names_and_types_by_node,
+                  node.get_service_names_and_types_by_node):
+        assert ros2_graph.of_node(query, "no_such_node", "/") == []
+
+
 @pytest.mark.parametrize("sig, status", [(signal.SIGINT, 2), (signal.SIGTERM, 15)])
 def test_a_signal_ends_an_endless_command_without_a_traceback(vehicle, ros, sig, status):
     ros.call(VehicleGetState, "/vehicle_node/get_state")

@@ -17,7 +17,8 @@ import rclpy
 from rclpy.action.graph import (get_action_client_names_and_types_by_node,
                                 get_action_names_and_types,
                                 get_action_server_names_and_types_by_node)
-from rclpy.node import Node
+from rclpy.impl.implementation_singleton import rclpy_implementation
+from rclpy.node import Node, NodeNameNonExistentError
 from rclpy.qos import qos_profile_sensor_data
 from rclpy.topic_or_service_is_hidden import topic_or_service_is_hidden
 
@@ -52,6 +53,15 @@ def settled(node: Node, snapshot: Callable[[], Any], found: Callable[[Any], bool
         if now != last:
             last, settled_at = now, time.monotonic()
     return last[0]
+
+
+def of_node(query: Callable[..., NamesAndTypes], *args: Any) -> NamesAndTypes:
+    """query(*args), a by-node graph query; nothing for a node that left the graph since it was
+    listed (rcl then fails, "error not set" for an action's ends): it has no endpoints now."""
+    try:
+        return query(*args)
+    except (NodeNameNonExistentError, rclpy_implementation.RCLError):
+        return []
 
 
 def visible(names_and_types: NamesAndTypes, include_hidden: bool) -> list:
@@ -108,8 +118,8 @@ def node_info(node: Node, a: argparse.Namespace) -> None:
                    node.get_publisher_names_and_types_by_node,
                    node.get_service_names_and_types_by_node,
                    node.get_client_names_and_types_by_node)
-        found = [visible(f(name, namespace), a.include_hidden) for f in by_node]
-        found += [visible(f(node, name, namespace), a.include_hidden)
+        found = [visible(of_node(f, name, namespace), a.include_hidden) for f in by_node]
+        found += [visible(of_node(f, node, name, namespace), a.include_hidden)
                   for f in (get_action_server_names_and_types_by_node,
                             get_action_client_names_and_types_by_node)]
         return (True, *found)
@@ -248,7 +258,7 @@ def action_info(node: Node, a: argparse.Namespace) -> None:
             for found, by_node in ((clients, get_action_client_names_and_types_by_node),
                                    (servers, get_action_server_names_and_types_by_node)):
                 found += [(full_name(node_name, namespace), list(t))
-                          for n, t in by_node(node, node_name, namespace) if n == name]
+                          for n, t in of_node(by_node, node, node_name, namespace) if n == name]
         return sorted(clients), sorted(servers)
     clients, servers = settled(node, ends)
     print(f"Action: {a.action_name}")
