@@ -47,7 +47,7 @@ setup:
 	took=$$((SECONDS - start)) && printf 'setup done in %d:%02d\n' $$((took / 60)) $$((took % 60))
 
 stage-interfaces:
-	@+$(STAGE) "interfaces: acti_msgs and the standard ones PyPI lacks" $(SETUP_LOG)/interfaces.log \
+	@+$(STAGE) "interfaces (ours, those PyPI lacks), the C response send" $(SETUP_LOG)/interfaces.log \
 	  $(SUBMAKE) $(BUILD_STAMP)
 
 # The CP plan's kernels need only numpy and numba: compiled into numba's cache while the
