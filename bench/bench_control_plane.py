@@ -43,7 +43,7 @@ from dataclasses import dataclass
 from typing import Any, Callable, Iterator
 
 import numpy as np
-from common import Actions, RosClient, bare_call, p, running
+from common import Actions, RosClient, bare_call, bare_trigger_answers, p, running
 
 import rclpy
 from acti_msgs import srv
@@ -477,6 +477,7 @@ def main(cases: str) -> None:
     with running("bench.trigger_server"), running("bench.clock_floor"), \
             running("acti_bringup", *params):
         bg = Background()
+        bare_trigger_answers(ros)
         prepare(ros)
         assert ros.spin_until(lambda: len(bg.clock_values) > 100, 30.0), "no /clock"
         period = bg.control_period()

@@ -11,8 +11,8 @@ import time
 
 import numpy as np
 
-from common import (RosClient, against, bare_call, idle_cpu_percent, interleaved, p, paired,
-                    running, table, worst_ratios)
+from common import (RosClient, against, answered, bare_call, bare_trigger_answers,
+                    idle_cpu_percent, interleaved, p, paired, running, table, worst_ratios)
 
 from bench.trigger_server import GETTERS, REPLAY
 
@@ -24,12 +24,15 @@ ROUNDS = 100
 def main() -> None:
     ros = RosClient()
     with running("bench.trigger_server"), running("acti_bringup") as job:
+        bare_trigger_answers(ros)
         getters = [(name, lambda s=srv_type, n=name: ros.call(s, n)) for name, srv_type in GETTERS]
         pairs = paired(bare_call(ros), getters, N, rounds=BLOCKS)
         rounds = interleaved(against(("bare Trigger", bare_call(ros)), getters), ROUNDS)
         time.sleep(3.0)          # the calls' tail (DDS acknowledgements, collections) ends
         cpu = idle_cpu_percent(job.proc.pid, seconds=20.0)
         with running("bench.trigger_server", args=("replay",)):
+            for name, srv_type in GETTERS:
+                answered(ros, srv_type, REPLAY + name)
             replays = {name: lambda s=srv_type, n=name: ros.call(s, REPLAY + n)
                        for name, srv_type in GETTERS}
             same = paired(replays, getters, N, rounds=BLOCKS)
