@@ -80,3 +80,24 @@ def test_a_reply_key_is_the_same_for_the_same_values_in_any_container_and_none_w
     assert reply_key(0, "", {"a": None}) == (0, "", (("a", None),))
     assert reply_key(0, "", {"a": {"b": 1}}) is None
     assert reply_key(0, "", {"a": [1, {"b": 1}]}) is None
+
+
+def test_requests_are_read_as_core_values_by_readers_decided_per_type():
+    """A request's fields as the core takes them (`request_reader`): a nested message as the
+    tuple of its fields, its array a list of floats; a sequence of messages a list of tuples;
+    a scalar as it is. `to_core` reads any message the same way."""
+    from acti_msgs.msg import CarPosWithElbow, LimitValue
+    from acti_msgs.srv import MoveLinearCartesianRel, SetSoftLimitJoint, SetSpeedJoint
+    from acti_bringup.serving.conversions import request_reader, to_core
+    hg = [1.0, 0.0, 0.0, 20.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+    move = MoveLinearCartesianRel.Request(car_point=CarPosWithElbow(car_pos=hg, elbow=30.0,
+                                                                    struct_flag=2))
+    read = request_reader(MoveLinearCartesianRel.Request)(move)
+    assert read == {"car_point": (hg, 30.0, 2)} and type(read["car_point"][0]) is list
+    limits = SetSoftLimitJoint.Request(soft_limit=[LimitValue(upper=170.0, lower=-170.0),
+                                                   LimitValue(upper=120.0, lower=-120.0)])
+    assert request_reader(SetSoftLimitJoint.Request)(limits) == {"soft_limit": LIMITS}
+    assert request_reader(SetSpeedJoint.Request)(SetSpeedJoint.Request(spd_ratio=40)) == \
+        {"spd_ratio": 40}
+    assert to_core(move.car_point) == (hg, 30.0, 2)
+    assert to_core(limits) == (LIMITS,)
