@@ -43,7 +43,7 @@ def hg_to_pose(values: Iterable[float], name: str,
     R = np.array(rows)
     gram = R.T @ R
     gram.flat[::4] -= 1.0
-    err = float(np.abs(gram).max())
+    err = float(np.maximum.reduce(np.abs(gram), axis=None))   # (`.max()` is a Python call)
     det = _det3(rows)
     if err > ROTATION_TOLERANCE or det <= 0:
         raise Refused(code, f"{name}: the 3×3 part is not a rotation (orthonormal, det +1): "
