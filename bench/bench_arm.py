@@ -8,11 +8,14 @@ import os
 import shutil
 import tempfile
 import time
+from contextlib import contextmanager
+from typing import Iterator
 
 import numpy as np
 from common import (RosClient, answered, bare_call, bare_trigger_answers, cpu_seconds, paired,
                     running, simulated_arm, table)
 
+from bench.clock_floor import NICENESS
 from bench.trigger_server import REPLAY
 
 from acti_msgs import srv
@@ -67,15 +70,16 @@ def accept_latency() -> None:
                     "move_ptp_joint_rel": (srv.MovePTPJointRel, {"joint_points": [0.0] * 7}),
                     "move_linear_cartesian_rel": (srv.MoveLinearCartesianRel,
                                                   {"car_point": CarPosWithElbow(car_pos=IDENTITY)})}
-        with running("bench.trigger_server", args=("replay", *(ARM + op for op in replayed))):
-            for op, (srv_type, fields) in replayed.items():
-                answered(ros, srv_type, REPLAY + ARM + op, **fields)
+        moves = [(name, fn) for name, fn in calls.items() if name != "get_state while moving"]
+        with replay_server(ros, replayed):
             same = paired({name: lambda fn=fn: fn(REPLAY) for name, fn in calls.items()},
                           list(calls.items()), N, warmup=WARMUP, rounds=BLOCKS)
-            cpu = {name: planning_cpu(node.proc.pid, fn) for name, fn in calls.items()
-                   if name != "get_state while moving"}
+            cpu = {name: planning_cpu(node.proc.pid, fn) for name, fn in moves}
             moving = ros.call(srv.GetState, ARM + "get_state").state & 0x02
             same.update(idle_accepts(ros))
+        with replay_server(ros, replayed, f"--nice={NICENESS}"):
+            ranked = paired({name: lambda fn=fn: fn(REPLAY) for name, fn in moves}, moves, N,
+                            warmup=WARMUP, rounds=BLOCKS)
 
     with open(handlers) as f:                      # written as the node ended
         handler_times = json.load(f)
@@ -86,6 +90,10 @@ def accept_latency() -> None:
           "(a move: OK, nothing planned): the node's own cost, the plan's among it (goals: PTP "
           "accept <= 1.3, CP 20 mm accept <= 2, p50 and p99)", same,
           "bare replay", "the same service types")
+    table(f"the moves against that bare server with its threads at the job's niceness ({NICENESS}), "
+          "as the job runs: the node's own work; the difference to the ratios above is what the "
+          "job's precedence over this client (niceness 0) costs it where they share the cores",
+          ranked, "bare replay at the job's niceness", "the same service types")
     print(f"CPU per accept in the node (over its CPU meanwhile without calls, the arm moving: "
           f"taking the request, the checks and the plan, the answer), {CPU_CALLS} accepts each:")
     for name, seconds in cpu.items():
@@ -100,6 +108,17 @@ def accept_latency() -> None:
         print(f"  {service:<42} {cpu_s * 1e6:7.0f} us CPU  {wall_s * 1e6:7.0f} us wall"
               f"   ({len(calls)} calls)")
     ros.close()
+
+
+@contextmanager
+def replay_server(ros: RosClient, replayed: dict[str, tuple[type, dict]],
+                  *options: str) -> Iterator[None]:
+    """`bench.trigger_server replay` of these arm operations (each with a call that moves
+    nothing), each answering once before it is measured (`answered`)."""
+    with running("bench.trigger_server", args=("replay", *options, *(ARM + op for op in replayed))):
+        for op, (srv_type, fields) in replayed.items():
+            answered(ros, srv_type, REPLAY + ARM + op, **fields)
+        yield
 
 
 def idle_accepts(ros: RosClient) -> dict:

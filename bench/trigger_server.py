@@ -8,14 +8,18 @@ driven by a spin_once loop), so the ratio measures the nodes' own cost, not an e
                                                            /bare_follow/follow_joint_trajectory, on the
                                                            goal plane's executor (single): it accepts
                                                            every goal and succeeds at once
-    python -m bench.trigger_server replay [SERVICE ...]    the services named (default: every getter
+    python -m bench.trigger_server replay [--nice=N] [SERVICE ...]
+                                                           the services named (default: every getter
                                                            of both nodes) as /bare_replay/<node>/<op>:
                                                            a getter answers the reply the running main
                                                            job gave it once, any other operation an
                                                            OK reply (motion id 1) and does nothing;
                                                            served as the job serves them: the same
                                                            QoS (SERVICE_QOS) and introspection (the
-                                                           job's default `service_introspection`)
+                                                           job's default `service_introspection`);
+                                                           with --nice, its threads at that niceness
+                                                           (the job's: what a bare node deployed as
+                                                           the job is costs)
 
 The replay server tells a call's cost over a bare node answering the same messages (what the
 ROS layer and, for a move, its plan cost) apart from its cost over a Trigger (which adds the
@@ -27,6 +31,7 @@ from rclpy.executors import MultiThreadedExecutor, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
 from std_srvs.srv import Trigger
 
+from acti_bringup.priority import set_niceness
 from acti_bringup.serving.spinning import SpinLoop, init, wait_for_signal
 from acti_middle_node.operations import OPERATIONS as ARM_OPERATIONS
 from vehicle_node.operations import OPERATIONS as BASE_OPERATIONS
@@ -93,16 +98,23 @@ def replay_node(names: list[str]) -> rclpy.node.Node:
     return node
 
 
+NICE = "--nice="
+
+
 def main() -> None:
     args = rclpy.utilities.remove_ros_args(sys.argv)
     kind = args[1] if len(args) > 1 else KIND
+    nice = [int(a.removeprefix(NICE)) for a in args if a.startswith(NICE)]
     init(sys.argv)
     if kind == "replay":
-        node = replay_node(args[2:] or [name for name, _ in GETTERS])
+        node = replay_node([a for a in args[2:] if not a.startswith(NICE)]
+                           or [name for name, _ in GETTERS])
     elif kind == "follow":
         node = follow_node()
     else:
         node = trigger_node()
+    if nice and not set_niceness(nice[-1], print):
+        raise SystemExit(f"niceness {nice[-1]} refused")
     executor = EXECUTORS[{"replay": KIND, "follow": "single"}.get(kind, kind)]()
     executor.add_node(node)
     loop = SpinLoop(executor, "bare").start()
