@@ -26,6 +26,8 @@ clients that arrive before it takes its own loses it: the harness's keep 100, `C
     python bench/bench_control_plane.py            (a few minutes)
     python bench/bench_control_plane.py --cases cd (only cases (c) and (d))
     python bench/bench_control_plane.py --cases e  (only the program case)
+    python bench/bench_control_plane.py --trials N (N trials per case and device, not 20: a
+                                                    tail needs more)
     python bench/bench_control_plane.py --cases f  (busy processes at the job's niceness: as
                                                     other jobs on the machine, e.g. tests')
     python bench/bench_control_plane.py --storm S  (one storm client for S seconds: used by (d))
@@ -283,9 +285,9 @@ def running_motion(ros: RosClient, device: Device, waiter: Actions,
 
 
 def run_trials(ros: RosClient, bg: Background, device: Device, load: Load,
-               waiter: Actions) -> Figures:
+               waiter: Actions, trials: int) -> Figures:
     f = Figures([], [], [], [], [], [], 0.0, 0.0, 0.0, [])
-    for trial in range(-1, TRIALS):                     # trial -1 warms up (lazy imports)
+    for trial in range(-1, trials):                     # trial -1 warms up (lazy imports)
         if trial == 0:
             f, t0 = Figures([], [], [], [], [], [], 0.0, 0.0, 0.0, []), time.monotonic()
         try:
@@ -464,8 +466,8 @@ def lost_text(lost: list[str], dropped: int) -> str:
         f"{lost.count(why)}x {why}" for why in dict.fromkeys(lost)) + drops
 
 
-def main(cases: str) -> None:
-    """`cases`: the letters of the cases to run (all when empty)."""
+def main(cases: str, trials: int = TRIALS) -> None:
+    """`cases`: the letters of the cases to run (all when empty); `trials` per case and device."""
     record_answer_stamps()
     ros = RosClient(call_timeout=5.0)
     # /clock on every control step (clock_rate_hz = rate_hz), so its gaps show every stall
@@ -481,7 +483,7 @@ def main(cases: str) -> None:
         prepare(ros)
         assert ros.spin_until(lambda: len(bg.clock_values) > 100, 30.0), "no /clock"
         period = bg.control_period()
-        print(f"stop under load, main job, {TRIALS} trials per case; control period "
+        print(f"stop under load, main job, {trials} trials per case; control period "
               f"{period * 1e3:.2f} ms (from /clock); times in ms")
         print(f"{'case':<40} {'dev':<5} {'bare p50/p99':>15} {'stop reply p50/p99/max':>25} "
               f"{'ratio p99':>9} {'in job p50/p99/max':>22} {'rest p50/p99/max':>25} {'goal':>7} "
@@ -495,7 +497,7 @@ def main(cases: str) -> None:
             with context():
                 for device in DEVICES:
                     drops = udp_receive_drops()
-                    f = run_trials(ros, bg, device, load, waiters[device.name])
+                    f = run_trials(ros, bg, device, load, waiters[device.name], trials)
                     drops = udp_receive_drops() - drops
                     reply, rest = np.array(f.reply), np.array(f.rest_job)
                     in_job = np.array(f.in_job or [np.nan])
@@ -519,4 +521,6 @@ if __name__ == "__main__":
     if len(sys.argv) == 3 and sys.argv[1] == "--storm":
         storm_client(float(sys.argv[2]))
     else:
-        main(sys.argv[sys.argv.index("--cases") + 1] if "--cases" in sys.argv else "")
+        def option(name: str, default: str) -> str:
+            return sys.argv[sys.argv.index(name) + 1] if name in sys.argv else default
+        main(option("--cases", ""), int(option("--trials", str(TRIALS))))

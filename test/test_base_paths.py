@@ -5,7 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from acti_motion.vehicle.paths import Pose2D, Ramp, arc, line, straight_to, turn, velocity_path
+from acti_motion.vehicle.paths import (ConstantTwist, Moved, Odometry, Pose2D, Ramp, Tail,
+                                       TrackedBaseMotion, arc, line, straight_to, turn,
+                                       velocity_path)
 
 LIMITS = (0.5, math.radians(45.0), 0.4, math.radians(90.0))
 
@@ -66,3 +68,50 @@ def test_velocity_path_slews_holds_and_stops():
     assert p.twist(1.5) == pytest.approx((0.4, 0.2), abs=1e-9)
     assert p.duration == pytest.approx(3.0, abs=0.01)                    # 2 s + 1 s to stop
     assert p.twist(p.duration) == (0.0, 0.0)
+
+
+
+def _dense_peak(twist, t0, t1, dt=1e-4):
+    """The largest |v| and |w| of twist(t) sampled every dt over [t0, t1)."""
+    twists = np.abs([twist(t) for t in np.arange(t0, t1, dt)] or [(0.0, 0.0)])
+    return tuple(twists.max(axis=0))
+
+
+def _paths():
+    start = Pose2D(0.3, -0.2, 0.4)
+    chain = straight_to(start, Pose2D(1.5, 0.8, -1.0), LIMITS, True)
+    drive = velocity_path(start, 0.1, -0.2, (0.45, 0.5), 1.5, (0.4, 1.0))
+    return {"line": line(start, 1.2, LIMITS), "turn": turn(start, -2.0, LIMITS),
+            "arc": arc(start, -0.4, 1.5, LIMITS), "chain": chain, "velocity drive": drive,
+            "sampled": drive.paths[0], "re-timed chain": chain.retimed(2.0, LIMITS),
+            "moved": Moved(chain, Pose2D(1.0, 1.0, 1.0)), "tail": Tail(drive, 0.7),
+            "constant": ConstantTwist(start, (-0.3, 0.2), 1.0)}
+
+
+@pytest.mark.parametrize("name", sorted(_paths()))
+def test_peak_is_the_largest_speed_and_yaw_rate_over_the_span(name):
+    """peak(t0, t1) is exact (a dense sampling comes within its step's change) over spans inside,
+    across and outside the path; a point span is the twist there. The base's stop ramp takes
+    it for the highest speed a path still reaching it reaches while it stops."""
+    path = _paths()[name]
+    d = path.duration
+    for t0, t1 in ((0.0, d), (0.1 * d, 0.35 * d), (0.3 * d, 0.9 * d), (0.6 * d, d + 1.0),
+                   (-1.0, 0.2 * d), (d, d + 1.0), (-2.0, -1.0)):
+        got, dense = path.peak(t0, t1), _dense_peak(path.twist, t0, t1)
+        assert got == pytest.approx(dense, abs=1e-3), (t0, t1)
+        assert got[0] >= dense[0] - 1e-12 and got[1] >= dense[1] - 1e-12, (t0, t1)
+    t = 0.4 * d
+    assert path.peak(t, t) == pytest.approx(tuple(map(abs, path.twist(t))))
+
+
+def test_a_motions_reference_peak_follows_each_segment_over_its_own_time():
+    """Across a splice, each path counts only while it is the reference: the slow path spliced
+    in hides the first one's speed from the splice on."""
+    start = Pose2D(0.0, 0.0, 0.0)
+    odometry = Odometry(0.1, 0.4, np.zeros(2))
+    motion = TrackedBaseMotion(odometry, line(start, 3.0, LIMITS))
+    motion.splice(1.0, ConstantTwist(start, (0.1, 0.0), 4.0))
+    assert motion.reference_peak(0.0, 0.9) == pytest.approx(
+        _dense_peak(motion.reference_twist, 0.0, 0.9), abs=1e-3)
+    assert motion.reference_peak(1.0, 4.0) == pytest.approx((0.1, 0.0))
+    assert motion.reference_peak(0.5, 2.0) == pytest.approx((0.4, 0.0))   # 0.4 m/s² for 1 s

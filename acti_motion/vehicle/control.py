@@ -254,17 +254,17 @@ class Control:
         resume) at `accel` (mm/s², degree/s²). Speed = rate × path speed, so where the path
         itself slows down (or, ramping up, speeds up) just now, its own acceleration adds to the
         ramp's: the ramp takes only what is left of `accel` beside it (at least a quarter); and
-        stopping takes down the highest speed the path reaches meanwhile."""
+        stopping takes down the highest speed the path reaches meanwhile (`reference_peak`:
+        exact, where nine samples of the span could miss it between them, at half their cost
+        to the control plane)."""
         device, dt = self.device, self._dt
         cur = device.current
-        if cur is None or not hasattr(cur.motion, "reference_twist"):
-            def twist(_: float) -> tuple[float, float]:
-                return self.odometry.v, self.odometry.w
-        else:
-            def twist(t: float) -> tuple[float, float]:
-                return cur.motion.reference_twist(t)
+        motion = cur.motion if cur is not None and hasattr(cur.motion, "reference_twist") else None
         t = device.t
-        now, later = twist(t), twist(t + dt)
+        if motion is None:
+            now = later = (self.odometry.v, self.odometry.w)
+        else:
+            now, later = motion.reference_twist(t), motion.reference_twist(t + dt)
         ramp = 0.02
         for i, a in enumerate(si_pair(accel)):
             change = (abs(later[i]) - abs(now[i])) / dt
@@ -272,7 +272,7 @@ class Control:
             speed = abs(now[i])
             if not up and change > 0.0:            # the path still speeds up while it stops
                 span = speed * (1.0 + change / a) / a
-                speed = max(abs(twist(t + span * k / 8)[i]) for k in range(9))
+                speed = max(speed, motion.reference_peak(t, t + span)[i])
             ramp = max(ramp, speed / max(a - adds, a / 4))
         return ramp
 

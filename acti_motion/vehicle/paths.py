@@ -1,7 +1,7 @@
 """Differential-drive base: wheel odometry, reference paths and pose-tracking motions (SI: m, rad, s).
 
-A *path* is a reference in its own time from 0: `duration`, `pose(t)` (odometry frame) and
-`twist(t)` = (forward speed, yaw rate). A `TrackedBaseMotion` follows one on the odometry with
+A *path* is a reference in its own time from 0: `duration`, `pose(t)` (odometry frame),
+`twist(t)` = (forward speed, yaw rate) and `peak(t0, t1)`, the largest of each over a span. A `TrackedBaseMotion` follows one on the odometry with
 Kanayama's tracking law; while it runs, the rest of its path can be replaced (`splice`), which is
 how a jog, a continuous move or a cruise take a new target without stopping.
 """
@@ -11,7 +11,7 @@ import bisect
 import math
 import threading
 from dataclasses import dataclass
-from typing import Callable, Protocol, Sequence
+from typing import Callable, Iterable, Protocol, Sequence
 
 import numpy as np
 
@@ -145,6 +145,10 @@ class Path(Protocol):
     def twist(self, t: float) -> tuple[float, float]:
         """(forward speed m/s, yaw rate rad/s) at t; (0, 0) outside [0, duration]."""
 
+    def peak(self, t0: float, t1: float) -> tuple[float, float]:
+        """The largest |forward speed| and |yaw rate| over [t0, t1], exactly: every path's
+        twist is piecewise linear in t, so it peaks at an end of the span or at a corner."""
+
     def retimed(self, t: float, limits: "Limits") -> "Path | None":
         """The rest of the path from t on, timed for new limits from the speed at t (same
         geometry, same end); None when this kind of path keeps its timing."""
@@ -199,6 +203,13 @@ class Ramp:
         dt = t - t0
         return s0 + v0 * dt + a * dt * dt / 2, v0 + a * dt
 
+    def peak_rate(self, t0: float, t1: float) -> float:
+        """The largest ds/dt over [t0, t1]: at an end or at a corner between them (the rate is
+        linear between corners)."""
+        corners = self._starts[bisect.bisect_right(self._starts, t0):
+                               bisect.bisect_left(self._starts, t1)]
+        return max(self.sample(t)[1] for t in (t0, t1, *corners))
+
 
 class CurvePath:
     """A curve of constant shape driven by a `Ramp` on its parameter s: a straight line (s in m),
@@ -234,6 +245,13 @@ class CurvePath:
             return 0.0, 0.0
         sd = self.ramp.sample(t)[1]
         return self.unit[0] * sd, self.unit[1] * sd
+
+    def peak(self, t0: float, t1: float) -> tuple[float, float]:
+        t0, t1 = max(t0, 0.0), min(t1, self.duration)
+        if t0 > t1 or t0 >= self.duration:
+            return 0.0, 0.0
+        sd = self.ramp.peak_rate(t0, t1)
+        return abs(self.unit[0]) * sd, abs(self.unit[1]) * sd
 
     def retimed(self, t: float, limits: Limits) -> "CurvePath":
         s, sd = self.ramp.sample(t) if t < self.duration else (self.ramp.length, 0.0)
@@ -286,6 +304,13 @@ class Chain:
         path, tau = self._find(t)
         return path.twist(tau)
 
+    def peak(self, t0: float, t1: float) -> tuple[float, float]:
+        if not self.paths or t1 < 0.0 or t0 >= self.duration:
+            return 0.0, 0.0
+        first, last = self._index(t0), self._index(t1)
+        return peak_of(self.paths[i].peak(t0 - self.starts[i], t1 - self.starts[i])
+                       for i in range(first, last + 1))
+
     def head(self, t: float) -> "list[Path] | None":
         """The parts that make the path up to time t (the last one cut there), or None when
         the part running at t cannot be cut."""
@@ -319,6 +344,12 @@ class Tail:
     def twist(self, t: float) -> tuple[float, float]:
         return self.path.twist(self.start + t) if 0.0 <= t < self.duration else (0.0, 0.0)
 
+    def peak(self, t0: float, t1: float) -> tuple[float, float]:
+        t0, t1 = max(t0, 0.0), min(t1, self.duration)
+        if t0 > t1 or t0 >= self.duration:
+            return 0.0, 0.0
+        return self.path.peak(self.start + t0, self.start + t1)
+
 
 def retimed_or_kept(path: Path, t: float, limits: Limits) -> Path:
     new = getattr(path, "retimed", lambda *_: None)(t, limits)
@@ -339,6 +370,9 @@ class Moved:
 
     def twist(self, t: float) -> tuple[float, float]:
         return self.path.twist(t)
+
+    def peak(self, t0: float, t1: float) -> tuple[float, float]:
+        return self.path.peak(t0, t1)
 
     def retimed(self, t: float, limits: Limits) -> "Moved | None":
         inner = getattr(self.path, "retimed", lambda *_: None)(t, limits)
@@ -376,9 +410,11 @@ class SampledPath:
         self.duration = float(t[-1])
 
     def _index(self, t: float) -> tuple[int, float]:
-        i = min(max(int(np.searchsorted(self.t, t, side="right")) - 1, 0), len(self.t) - 2)
-        span = self.t[i + 1] - self.t[i]
-        return i, 0.0 if span <= 0 else min(1.0, max(0.0, (t - self.t[i]) / span))
+        ts = self.t
+        i = min(max(int(ts.searchsorted(t, "right")) - 1, 0), len(ts) - 2)
+        t_i = float(ts[i])
+        span = float(ts[i + 1]) - t_i
+        return i, 0.0 if span <= 0 else min(1.0, max(0.0, (t - t_i) / span))
 
     def pose(self, t: float) -> Pose2D:
         if len(self.t) == 1:
@@ -393,6 +429,16 @@ class SampledPath:
         i, f = self._index(t)
         return (float(self.v[i] + f * (self.v[i + 1] - self.v[i])),
                 float(self.w[i] + f * (self.w[i + 1] - self.w[i])))
+
+    def peak(self, t0: float, t1: float) -> tuple[float, float]:
+        t0, t1 = max(t0, 0.0), min(t1, self.duration)
+        if t0 > t1 or t0 >= self.duration or len(self.t) == 1:
+            return 0.0, 0.0
+        inside = slice(int(self.t.searchsorted(t0, "right")), int(self.t.searchsorted(t1, "left")))
+        # at the end itself the path has stopped: its last sample is what it reaches
+        end = self.twist(t1) if t1 < self.duration else (float(self.v[-1]), float(self.w[-1]))
+        return peak_of((self.twist(t0), end, (float(np.abs(self.v[inside]).max(initial=0.0)),
+                                              float(np.abs(self.w[inside]).max(initial=0.0)))))
 
 
     def head(self, t: float) -> "SampledPath":
@@ -418,6 +464,18 @@ class ConstantTwist:
 
     def twist(self, t: float) -> tuple[float, float]:
         return (self.v, self.w) if 0.0 <= t < self.duration else (0.0, 0.0)
+
+    def peak(self, t0: float, t1: float) -> tuple[float, float]:
+        inside = t0 < self.duration and t1 >= 0.0 and t0 <= t1
+        return (abs(self.v), abs(self.w)) if inside else (0.0, 0.0)
+
+
+def peak_of(twists: "Iterable[tuple[float, float]]") -> tuple[float, float]:
+    """The largest |forward speed| and |yaw rate| among `twists`."""
+    v = w = 0.0
+    for tv, tw in twists:
+        v, w = max(v, abs(tv)), max(w, abs(tw))
+    return v, w
 
 
 SLEW_SAMPLES = 2000          # at most this many samples per speed change of a velocity drive
@@ -517,6 +575,14 @@ class TrackedBaseMotion:
     def reference_twist(self, t: float) -> tuple[float, float]:
         t0, path = self._segment(t)
         return path.twist(t - t0)
+
+    def reference_peak(self, t0: float, t1: float) -> tuple[float, float]:
+        """The reference's largest |forward speed| and |yaw rate| over motion times [t0, t1]:
+        each segment's path over the part of the span it is the reference for."""
+        ends = [start for start, _ in self.segments[1:]] + [math.inf]
+        return peak_of(path.peak(max(t0, start) - start, min(t1, end) - start)
+                       for (start, path), end in zip(self.segments, ends)
+                       if start <= t1 and end > t0)
 
     def splice(self, t: float, path: Path) -> None:
         """Follow `path` (which starts at the reference state at t) from motion time t on."""
