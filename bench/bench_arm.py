@@ -87,12 +87,13 @@ def accept_latency() -> None:
     table(f"round trip over DDS, {N} alternations (bare, call) for each call in {BLOCKS} blocks "
           f"spread over the run, arm moving: {bool(moving)} (real time)", pairs, "bare Trigger")
     table("the same calls against a bare server that answers the same messages at once "
-          "(a move: OK, nothing planned): the node's own cost, the plan's among it (goals: PTP "
-          "accept <= 1.3, CP 20 mm accept <= 2, p50 and p99)", same,
-          "bare replay", "the same service types")
-    table(f"the moves against that bare server with its threads at the job's niceness ({NICENESS}), "
-          "as the job runs: the node's own work; the difference to the ratios above is what the "
-          "job's precedence over this client (niceness 0) costs it where they share the cores",
+          "(a move: OK, nothing planned), its threads at this client's niceness (0): what a "
+          "niceness-0 client on the job's cores sees, the job's precedence over it among it",
+          same, "bare replay", "the same service types")
+    table(f"the moves against that bare server served as the job is, its threads at the job's "
+          f"niceness ({NICENESS}) too: the node's own cost, the plan's among it (goals: PTP "
+          "accept <= 1.3, CP 20 mm accept <= 2, p50 and p99); the difference to the ratios above "
+          "is what the job's precedence costs a niceness-0 client where they share the cores",
           ranked, "bare replay at the job's niceness", "the same service types")
     print(f"CPU per accept in the node (over its CPU meanwhile without calls, the arm moving: "
           f"taking the request, the checks and the plan, the answer), {CPU_CALLS} accepts each:")

@@ -75,7 +75,8 @@ def follow_node() -> rclpy.node.Node:
 def replay_node(names: list[str]) -> rclpy.node.Node:
     """The services `names`, each answering one reply: a getter's fetched once from the running
     job, another operation's an OK reply that accepted nothing. With the job's QoS and its
-    default introspection, so that the ratio to it is the node's own cost, not a setting's."""
+    default introspection (and, given `--nice`, its niceness), so that the ratio to it is the
+    node's own cost, not a setting's."""
     from acti_bringup.harness import RosClient
     from acti_bringup.recording.introspection import introspect
     from acti_bringup.recording.job import RecordingConfig
