@@ -66,7 +66,7 @@ def test_a_drive_at_a_box_slows_in_the_caution_zone_and_stops_before_it(base, ex
 def test_stuck_ends_by_clear_alarm_or_a_motion_away(base, executor):  # noqa: F811
     drive_into_the_box(base, executor, lambda: base.move_forward(5000.0))
     x = truth_x(base)
-    base.set_jog_timeout(60000)                                 # wall time: the test steps fast
+    base.set_jog_timeout(60000)                                 # the jog outlasts the test
     assert base.clear_alarm().ok and state(base) == VehicleState.READY
     assert base.move_jog(200.0, 0.0, 0.0).ok                    # toward it again: Stuck at once
     run_until(executor, lambda: state(base) == VehicleState.STUCK, 2.0)

@@ -1,4 +1,4 @@
-"""Spec races and bounds of the base without ROS: the jog deadman counts wall time, pause where
+"""Spec races and bounds of the base without ROS: the jog deadman counts the job's clock, pause where
 nothing can move is ignored, clear_alarm clears all, a blocked move ends Stuck (not completed),
 battery alarms have hysteresis, and absurd inputs are refused without touching the queue, with
 every plan's cost bounded."""
@@ -31,7 +31,7 @@ def test_a_paused_jog_resumed_after_its_timeout_does_not_drive_again(base, execu
     assert base.pause().ok
     trace.until(lambda: state(base) == VehicleState.PAUSED, 2.0)
     deadline = base._drive_deadline
-    trace.until(lambda: time.monotonic() > deadline, 60.0)     # wall time passes while held
+    trace.until(lambda: executor.world.time > deadline, 60.0)  # the job's clock runs while held
     trace.step(0.05)
     held = position(base)
     assert base.resume().ok
@@ -47,7 +47,7 @@ def test_a_renewal_between_the_deadmans_check_and_its_brake_drives_on(base, exec
     assert base.set_jog_timeout(30000).ok
     assert base.move_jog(300.0, 0.0, 0.0).ok
     steps(executor, 0.3)
-    base._drive_deadline = time.monotonic() - 0.001          # a late client: the timeout passed
+    base._drive_deadline = executor.world.time - 0.001       # a late client: the timeout passed
     decided, go = threading.Event(), threading.Event()
     edit_planned, simulation = base.device.edit_planned, threading.current_thread()
 
@@ -68,21 +68,25 @@ def test_a_renewal_between_the_deadmans_check_and_its_brake_drives_on(base, exec
     assert base.odometry.v == pytest.approx(0.3, abs=0.01)   # it drives on
 
 
-def test_the_deadman_counts_wall_time_since_the_last_call(base, executor, trace):  # noqa: F811
-    """A simulation slower than the wall clock (here: not stepped at all) does not extend a jog:
-    once the timeout has passed in wall time, the next control period brakes it."""
+def test_the_deadman_counts_the_jobs_clock_not_the_wall_clock(base, executor, trace):  # noqa: F811
+    """A simulation that lags the wall clock (here: not stepped at all for longer than the
+    timeout) does not end a jog early: it drives its timeout of the job's clock after the last
+    call, as far as in a simulation at real time, so a recording replays it. Then the next
+    control period past the deadline brakes it."""
     ready(base)
     base.set_acceleration((1000.0, 180.0))
     base.set_jog_timeout(200)
     motion = base.move_jog(300.0, 0.0, 0.0).values["motion_id"]
-    trace.step(0.1)                                          # 0.1 s of path time
     deadline = base._drive_deadline
-    while time.monotonic() <= deadline:                      # wall time passes, the world waits
+    assert deadline == pytest.approx(executor.world.time + 0.2)
+    trace.step(0.1)
+    speed, wall = trace.points[-1].v, time.monotonic() + 0.3
+    while time.monotonic() <= wall:                          # wall time passes, the world waits
         threading.Event().wait(0.01)
-    speed = trace.points[-1].v
     trace.step(0.05)
-    assert base._deadman_fired == motion and base.device.t < 0.2
-    assert trace.points[-1].v < speed - 0.02                 # braking, 0.1 s before the path's hold
+    assert base._deadman_fired is None and trace.points[-1].v > speed + 0.02   # speeding up
+    trace.until(lambda: base._deadman_fired == motion, 1.0)
+    assert executor.world.time == pytest.approx(deadline, abs=executor.dt + 1e-9)
     trace.until_idle(2.0)
     trace.check()
 

@@ -69,7 +69,7 @@ class VehicleCore(Control, Planning, Sensing, Obstacles):
         self.digital_sensor_lock = False
         self._contact_armed = True
         self._stuck_since: float | None = None
-        self._drive_deadline = math.inf      # time.monotonic() at which a jog/joystick drive ends
+        self._drive_deadline = math.inf      # world time at which a jog/joystick drive ends
         self._deadman_fired: int | None = None
         self._op_generation = 0              # the device's generation when the planning operation began
         self._op_arrival = 0                 # the device's `arrival()` when it was called
@@ -90,6 +90,7 @@ class VehicleCore(Control, Planning, Sensing, Obstacles):
         self.joystick = False
         self._stick = (0.0, 0.0)             # the last Joy sample's deflections that drove the base
         self._dt = executor.dt
+        self._world = world                  # its clock: the job's (the deadman counts it)
         self._init_obstacles(obstacles or ObstacleConfig(), world)
         self.retimer = Retimer(self._retime_to_settings)     # its thread: retimer.start()
         warm_up(self._limits())           # the first request does not pay for first-use costs

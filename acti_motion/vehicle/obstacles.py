@@ -118,7 +118,6 @@ class Obstacles:
                              f"{config.caution_velocity:g} mm/s: as set_velocity, it must be within "
                              f"{lo:g} … {hi:g} mm/s")
         self.obstacle_config = config
-        self._world = world
         self.sighting: Sighting | None = None     # the latest one in a zone (for the view)
         self._capped = False
         on = config.caution_distance > 0 or config.stop_distance > 0

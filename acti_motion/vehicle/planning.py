@@ -9,7 +9,6 @@ the device's edits, which plan again when the device changed meanwhile. A part o
 from __future__ import annotations
 
 import math
-import time
 from contextlib import contextmanager
 from typing import Any, Callable, Iterator
 
@@ -327,7 +326,7 @@ class Planning:
         """A joystick drive takes a new velocity setting at once, not at the next Joy sample
         (1.4.27: its speed is limited by setVelocity; 1.4.32: a moving base changes speed to
         match), keeping its deadman's deadline."""
-        cur, left = self.device.current, self._drive_deadline - time.monotonic()
+        cur, left = self.device.current, self._drive_deadline - self._world.time
         if cur is None or cur.label != "joystick" or self._deadman_fired == cur.id \
                 or not 0.0 < left < math.inf:
             return
@@ -490,8 +489,8 @@ class Planning:
                label: str, take_over: bool, brake: bool = False) -> dict:
         """Velocity drive: re-plan the running jog/joystick motion from its reference a little
         ahead of now (speed continuous), take over another running move (`take_over`, else
-        refused), or start one on an idle base. The deadman ends it `hold` s of wall time from
-        now unless called again. A `brake` of the running drive goes in whatever is queued
+        refused), or start one on an idle base. The deadman ends it `hold` s of the job's clock
+        from now unless called again. A `brake` of the running drive goes in whatever is queued
         behind it, and discards that (planned from the drive's old end; the base goes Ready)."""
         def look(device: Device, attempt: int):
             cur = self._running(device)
@@ -535,8 +534,8 @@ class Planning:
                               "base (wait, or call stop)")
 
     def _arm_deadman(self, hold: float, target: tuple[float, float]) -> None:
-        """The drive ends `hold` s of wall time from now; a drive to rest ends by itself."""
-        self._drive_deadline = time.monotonic() + hold if target != (0.0, 0.0) else math.inf
+        """The drive ends `hold` s of the job's clock from now; a drive to rest ends by itself."""
+        self._drive_deadline = self._world.time + hold if target != (0.0, 0.0) else math.inf
         self._deadman_fired = None
 
     def _retime(self, velocity: tuple[float, float], acceleration: tuple[float, float]) -> None:

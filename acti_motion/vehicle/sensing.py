@@ -4,7 +4,6 @@ deadman. A part of VehicleCore (its state, locks and device), kept apart for its
 from __future__ import annotations
 
 import math
-import time
 from typing import Any
 
 from acti_motion.executor import Device
@@ -45,18 +44,19 @@ class Sensing:
                     self._halt("a contact (the base is Locked)")
         self._watch_tracking(world.time)
         self._watch_obstacles(world)
-        self._watch_deadman()
+        self._watch_deadman(world)
 
     def _contact_trips(self) -> bool:
         return self.digital_sensor_lock and self._contact_armed and not self.locked
 
-    def _watch_deadman(self) -> None:
-        """A jog or joystick drive not renewed within its timeout (wall time, so a pause does
-        not extend it) decelerates at the acceleration setting, or ends where it is when it is
-        held at rest."""
+    def _watch_deadman(self, world: World) -> None:
+        """A jog or joystick drive not renewed within its timeout decelerates at the
+        acceleration setting, or ends where it is when it is held at rest. The timeout counts
+        the job's clock (the world's, /clock), not the path's, so a pause does not extend it,
+        and a recording replays it: a simulation that lags the wall clock drives as far."""
         cur, device = self.device.current, self.device
         if (cur is None or cur.label not in VELOCITY_DRIVEN or self._deadman_fired == cur.id
-                or time.monotonic() < self._drive_deadline or device.stopping):
+                or world.time < self._drive_deadline or device.stopping):
             return
         accel = si_pair(self.acceleration)
 
@@ -74,7 +74,7 @@ class Sensing:
                                                               (0.0, 0.0), 0.0, accel)
 
             def commit(device: Device) -> None:
-                if time.monotonic() < self._drive_deadline:
+                if world.time < self._drive_deadline:
                     return          # renewed meanwhile (its commit holds this lock too)
                 cur.motion.splice(t, path)
                 self._deadman_fired = cur.id
