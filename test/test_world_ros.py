@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import yaml
 from acti_msgs import srv
-from acti_msgs.msg import VehiclePosition, VehicleStatus, VehicleVelocity
+from acti_msgs.msg import VehiclePoint, VehiclePosition, VehicleStatus, VehicleVelocity
 from geometry_msgs.msg import PoseWithCovarianceStamped, Twist, TwistStamped
 from nav_msgs.msg import OccupancyGrid, Odometry
 from rosgraph_msgs.msg import Clock
@@ -36,7 +36,13 @@ SERVICES = {"set_power": srv.VehicleSetPower, "set_servo": srv.VehicleSetServo,
             "get_state": srv.VehicleGetState, "set_velocity": srv.VehicleSetVelocity,
             "move_forward": srv.VehicleMoveForward, "clear_alarm": srv.VehicleClearAlarm,
             "get_active_alarm": srv.VehicleGetActiveAlarm, "move_jog": srv.VehicleMoveJog,
-            "move_linear_abs": srv.VehicleMoveLinearAbs, "get_position": srv.VehicleGetPosition}
+            "move_linear_abs": srv.VehicleMoveLinearAbs, "get_position": srv.VehicleGetPosition,
+            "move_turn": srv.VehicleMoveTurn, "move_linear_rel": srv.VehicleMoveLinearRel,
+            "move_circular_rel": srv.VehicleMoveCircularRel}
+# the "Ready only" moves (1.4.14, 1.4.17, 1.4.20, 1.4.21), each with a request that would move
+READY_ONLY_MOVES = {"move_forward": dict(x=100.0), "move_turn": dict(theta=10.0),
+                    "move_linear_rel": dict(pos=VehiclePosition(x=100.0, y=0.0, theta=0.0)),
+                    "move_circular_rel": dict(center_point=VehiclePoint(x=0.0, y=500.0), theta=10.0)}
 
 
 def call(ros, name, ns="", **fields):
@@ -105,11 +111,13 @@ def test_map_is_the_world_rasterised(ros, room):
 
 
 def test_a_move_at_the_table_slows_stops_short_and_is_stuck_until_cleared(ros, room):
+    """The obstacle zones over DDS, and (issue 35) the Ready-only moves refused in Stuck."""
     truth = Latest(ros, Odometry, "/vehicle_node/ground_truth")
     try:
         ready(ros)
         assert call(ros, "set_velocity", vel=VehicleVelocity(translation=600.0, rotation=45.0)).success
-        assert call(ros, "move_forward", x=3000.0).success
+        first = call(ros, "move_forward", x=3000.0)
+        assert first.success
         assert wait_until(lambda: state(ros) == 0x014, 60.0), "never Stuck"
         truth.wait(lambda m: len(m) > 10 and abs(m[-1].twist.twist.linear.x) < 1e-3
                    and abs(m[-10].twist.twist.linear.x) < 1e-3)
@@ -125,9 +133,18 @@ def test_a_move_at_the_table_slows_stops_short_and_is_stuck_until_cleared(ros, r
         obstacle = [a for a in alarms.active_alarms if a.code == 121]
         assert obstacle and "range" in obstacle[0].source and "bearing" in obstacle[0].source
         assert state(ros) == 0x014
-        # the way out: clear_alarm, then a move away
+        # issue 35: the Ready-only moves are refused in Stuck (move_turn was accepted against the
+        # wall): false, nothing queued, no motion id given
+        for name, fields in READY_ONLY_MOVES.items():
+            r = call(ros, name, **fields)
+            assert not r.success and r.motion_id == 0, (name, r.message)
+            assert f"the base is Stuck: {name} needs Ready" in r.message, r.message
+            assert state(ros) == 0x014
+        # the way out: clear_alarm, then a move away (the id after the first move's: the
+        # refusals took none)
         assert call(ros, "clear_alarm").success and state(ros) == 0x010
-        assert call(ros, "move_forward", x=-500.0).success
+        back = call(ros, "move_forward", x=-500.0)
+        assert back.success and back.motion_id == first.motion_id + 1
         assert wait_until(lambda: state(ros) == 0x010, 30.0)
         truth.wait(lambda m: m[-1].pose.pose.position.x < TABLE_FACE - FRONT - rest - 0.45)
     finally:
