@@ -273,6 +273,42 @@ def test_stop_or_servo_off_of_a_paused_arm_at_rest_answers_not_moving_at_once(ro
     ready(ros)
 
 
+def test_a_joint_soft_limit_narrowed_while_paused_stops_the_arm_at_it_on_resume(ros, arm_node):
+    """Issue 35: set_soft_limit_joint is accepted while a move is paused (paused is not moving),
+    and on resume the watch looks ahead by the braking distance: alarm 0x4 and J1 at rest AT
+    the new limit (it stopped 0.876 degree past it)."""
+    ready(ros)
+    call(ros, "set_speed_joint", srv.SetSpeedJoint, spd_ratio=20)
+    kept = call(ros, "get_soft_limit_joint", srv.GetSoftLimitJoint).soft_limit
+    start = call(ros, "get_feedback_pos_joint", srv.GetFeedbackPosJoint).pos[0]
+    try:
+        assert call(ros, "move_ptp_joint_rel", srv.MovePTPJointRel,
+                    joint_points=[40.0, 0, 0, 0, 0, 0, 0]).return_id.id == 0
+        assert wait_until(lambda: call(ros, "get_feedback_pos_joint", srv.GetFeedbackPosJoint)
+                          .pos[0] > start + 2.0, 10.0)
+        paused = call(ros, "pause", srv.Pause).return_id
+        assert paused.id == 0 and not paused.comment, paused.comment
+        assert wait_until(lambda: call(ros, "get_state", srv.GetState).state == 0x11, 30.0)
+        j1 = call(ros, "get_feedback_pos_joint", srv.GetFeedbackPosJoint).pos[0]
+        limit = j1 + 5.0
+        narrowed = [LimitValue(upper=v.upper, lower=v.lower) for v in kept]
+        narrowed[0] = LimitValue(upper=limit, lower=kept[0].lower)
+        r = call(ros, "set_soft_limit_joint", srv.SetSoftLimitJoint, soft_limit=narrowed)
+        assert r.return_id.id == 0, r.return_id.comment                 # paused is not moving
+        assert call(ros, "resume", srv.Resume).return_id.id == 0
+        assert wait_until(lambda: call(ros, "get_active_alarm", srv.GetActiveAlarm).alarms, 30.0)
+        alarm = call(ros, "get_active_alarm", srv.GetActiveAlarm).alarms[0]
+        assert (alarm.code, alarm.type) == (0x4, 1) and "J1" in alarm.description, alarm
+        assert wait_until(lambda: not call(ros, "get_state", srv.GetState).state & 0x02, 30.0)
+        rest = call(ros, "get_feedback_pos_joint", srv.GetFeedbackPosJoint).pos[0]
+        assert limit - 0.01 <= rest <= limit + 0.01, (rest, limit)     # at the limit, not past it
+    finally:
+        call(ros, "clear_alarms", srv.ClearAlarms)
+        r = call(ros, "set_soft_limit_joint", srv.SetSoftLimitJoint, soft_limit=kept)
+        assert r.return_id.id == 0, r.return_id.comment
+    ready(ros)
+
+
 def test_pause_right_after_accept_and_a_move_during_stop_over_dds(ros, arm_node, wait_motion):
     """The spec races over DDS: a pause answered right after a move was accepted holds it (was:
     "ignored: the arm is not moving"); a move sent while a stop decelerates is discarded."""
