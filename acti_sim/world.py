@@ -8,11 +8,13 @@ from __future__ import annotations
 import functools
 import math
 import os
+import threading
 from dataclasses import dataclass
 
 import numpy as np
 
 from acti_sim.quiet import output_silenced
+from acti_sim.unlocked_step import unlocked_step
 
 with output_silenced():         # its build time, printed on import
     import pybullet
@@ -38,15 +40,27 @@ OBSTACLE_RGBA = (0.62, 0.55, 0.45, 1.0)
 class PhysicsClient:
     """PyBullet's functions bound to one physics client. pybullet_utils' BulletClient binds them
     anew on every attribute access (an `inspect` call and a partial each time, several times a
-    step); here each is bound once, on first use."""
+    step); here each is bound once, on first use. The step runs without the GIL
+    (`acti_sim.unlocked_step`): every call holds the client's lock instead, so none runs
+    while the physics steps, whichever thread makes it."""
 
     def __init__(self) -> None:
         self._id = pybullet.connect(pybullet.DIRECT)
+        self.lock = threading.Lock()
+        self._step = unlocked_step(pybullet.__file__, self._id)
 
     def __getattr__(self, name: str):
-        fn = functools.partial(getattr(pybullet, name), physicsClientId=self._id)
-        setattr(self, name, fn)
-        return fn
+        fn, lock = functools.partial(getattr(pybullet, name), physicsClientId=self._id), self.lock
+
+        def locked(*args, **kwargs):
+            with lock:
+                return fn(*args, **kwargs)
+        setattr(self, name, locked)
+        return locked
+
+    def stepSimulation(self) -> None:  # noqa: N802 (pybullet's name)
+        with self.lock:
+            self._step()
 
 
 @dataclass(frozen=True)
