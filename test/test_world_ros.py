@@ -38,7 +38,9 @@ SERVICES = {"set_power": srv.VehicleSetPower, "set_servo": srv.VehicleSetServo,
             "get_active_alarm": srv.VehicleGetActiveAlarm, "move_jog": srv.VehicleMoveJog,
             "move_linear_abs": srv.VehicleMoveLinearAbs, "get_position": srv.VehicleGetPosition,
             "move_turn": srv.VehicleMoveTurn, "move_linear_rel": srv.VehicleMoveLinearRel,
-            "move_circular_rel": srv.VehicleMoveCircularRel}
+            "move_circular_rel": srv.VehicleMoveCircularRel,
+            "set_digital_sensor_lock": srv.VehicleSetDigitalSensorLock,
+            "unlock": srv.VehicleUnlock}
 # the "Ready only" moves (1.4.14, 1.4.17, 1.4.20, 1.4.21), each with a request that would move
 READY_ONLY_MOVES = {"move_forward": dict(x=100.0), "move_turn": dict(theta=10.0),
                     "move_linear_rel": dict(pos=VehiclePosition(x=100.0, y=0.0, theta=0.0)),
@@ -148,6 +150,70 @@ def test_a_move_at_the_table_slows_stops_short_and_is_stuck_until_cleared(ros, r
         assert wait_until(lambda: state(ros) == 0x010, 30.0)
         truth.wait(lambda m: m[-1].pose.pose.position.x < TABLE_FACE - FRONT - rest - 0.45)
     finally:
+        truth.close()
+
+
+TABLE_SIDE = 0.5                 # the table's north face (y) [m]
+RAYS_ACROSS = 0.35               # the zones' rays span the footprint's width (the wheels' boxes) [m]
+BUMPER_REACH = math.hypot(FRONT, 0.22)   # the bumper's corner from base_link: 0.389 m
+BESIDE = 0.87                    # y of a lane past the table: its side 0.37 m from base_link
+
+
+def at_rest(ros, truth):
+    assert wait_until(lambda: state(ros) == 0x010, 60.0), (
+        call(ros, "get_active_alarm", num_of_alarm=5),
+        truth.got[-1].pose.pose if truth.got else None)
+
+
+def test_a_contact_locks_the_base_and_clear_alarm_clears_its_alarm_not_the_lock(ros, room):
+    """Issue 35 over DDS: after a bumper contact (alarm 301, Locked), clear_alarm clears every
+    alarm (1.4.1), the contact's too, but the base stays Locked and refuses moves until unlock
+    (table 7, Locked: 解除指令受信まで; docs/interfaces.md). The contact: beside the table, a turn
+    in place (the obstacle zones watch translations only) sweeps the bumper's corner into it."""
+    truth = Latest(ros, Odometry, "/vehicle_node/ground_truth")
+    try:
+        ready(ros)
+        assert call(ros, "set_velocity",
+                    vel=VehicleVelocity(translation=600.0, rotation=45.0)).success
+        # a lane past the table, its side out of the zones' rays but within the bumper's sweep
+        for x in (600.0, 1800.0):
+            assert call(ros, "move_linear_abs", pos=VehiclePosition(x=x, y=1000.0 * BESIDE,
+                                                                    theta=0.0)).success
+            at_rest(ros, truth)
+        true = truth.wait(lambda m: m[-1].pose.pose.position.x > 1.7        # beside the table
+                          and abs(m[-1].twist.twist.linear.x) < 1e-3).pose.pose
+        assert true.position.x < 1.9, true
+        gap = true.position.y - TABLE_SIDE
+        assert RAYS_ACROSS + 0.005 < gap < BUMPER_REACH - 0.005, true
+        assert call(ros, "set_digital_sensor_lock", on_off=True).success
+        assert call(ros, "move_turn", theta=-90.0).success                 # towards the table
+        assert wait_until(lambda: state(ros) == 0x017, 60.0), state(ros)   # Locked
+        n = len(truth.got)
+        truth.wait(lambda m: len(m) > n + 10 and all(abs(s.twist.twist.angular.z) < 1e-3
+                                                     for s in m[-10:]))      # at rest
+        alarms = call(ros, "get_active_alarm", num_of_alarm=5)
+        assert [(a.code, a.type) for a in alarms.active_alarms] == [(301, 1)], alarms  # a FAULT
+        r = call(ros, "move_forward", x=-100.0)
+        assert not r.success and r.motion_id == 0 and "unlock" in r.message, r.message
+        # clear_alarm: every alarm, the contact's too …
+        r = call(ros, "clear_alarm")
+        assert r.success and r.message == "still active: Locked until unlock (a contact)", r.message
+        assert call(ros, "get_active_alarm", num_of_alarm=5).num_of_active_alarm == 0
+        # … but Locked is left by unlock only (1.4.34)
+        assert state(ros) == 0x017
+        r = call(ros, "move_turn", theta=10.0)
+        assert not r.success and r.motion_id == 0 and "unlock" in r.message, r.message
+        assert call(ros, "unlock").success
+        at_rest(ros, truth)
+        # the way out: turn back to face along the lane (away from the table), back out of it
+        theta = call(ros, "get_position").pos.theta
+        assert -90.0 < theta < -5.0, theta                                 # stopped on the way
+        assert call(ros, "move_turn", theta=-theta).success
+        at_rest(ros, truth)
+        assert call(ros, "move_forward", x=-1200.0).success
+        at_rest(ros, truth)
+    finally:
+        call(ros, "set_digital_sensor_lock", on_off=False)
         truth.close()
 
 
