@@ -1,16 +1,20 @@
 """A queued move survives every request the spec does not make a stop, on both nodes over DDS.
 
-Each case queues a slow move (the base: 250 mm in about 1.5 s; the arm: a slow PTP), in real
-time, waits until it runs, sends a few random requests to one service (its fields filled from
-the request type: good values beside NaN, inf, 1e308, 5e-324, zero and negative ones) while it
-runs, puts the speed settings back (a request may have made the move crawl: that is allowed, a
-discard is not) and waits for the move: `wait_motion` must say completed. One table for both nodes: per node, how to make it
-ready, how to queue its slow move, the services left out because the spec makes them a stop, a
-hold or a take-over (with the reason), and the fields held where only their other values stop
-(set_power and set_servo on: off is a stop). Every other service of the node's operation
-table is fuzzed. Seeds are fixed per service, so a failure repeats."""
+Each case queues a slow move (the base: 250 mm in about 1.5 s; the arm: a slow PTP) and a short
+one behind it, in real time, waits until the first runs (the second waits, queued and not
+started), sends a few random requests to one service (its fields filled from the request type:
+good values beside NaN, inf, 1e308, 5e-324, zero and negative ones), puts the speed settings
+back (a request may have made a move crawl: that is allowed, a discard is not) and waits for
+both moves: `wait_motion` must say completed for each. One table for both nodes: per node, how
+to make it ready, how to queue its two moves, the services left out because the spec makes them
+a stop, a hold or a take-over (with the reason), the fields held where only their other values
+stop (set_power and set_servo on: off is a stop), and the services sent only values the node
+must refuse (the arm's soft limits: a valid narrower one stops the arm by design, a refused one
+must change nothing), each answer checked to be a refusal. Every other service of the node's
+operation table is fuzzed. Seeds are fixed per service, so a failure repeats."""
 from __future__ import annotations
 
+import functools
 import math
 import random
 import zlib
@@ -20,7 +24,7 @@ from typing import Any, Callable
 import pytest
 from acti_msgs import srv
 from acti_msgs.action import VehicleWaitMotion, WaitMotion
-from acti_msgs.msg import VehicleVelocity
+from acti_msgs.msg import LimitValue, VehiclePosition, VehicleVelocity
 from rosidl_parser.definition import AbstractNestedType, Array, BasicType, NamespacedType
 
 from acti_bringup.serving.conversions import _message_class, fill
@@ -68,16 +72,20 @@ def random_fields(srv_type: type, rng: random.Random) -> dict[str, Any]:
 
 @dataclass(frozen=True)
 class Node:
-    """One node of the table: its services, how to ready it and queue its slow move (the
-    move's id), how to put its speed back, its wait action and what is left out."""
+    """One node of the table: its services, how to ready it and queue its two moves (their
+    ids: the slow one, the short one behind it), how to put its speed back, its wait action,
+    what is left out, and the services fuzzed with refused values only (a generator of a
+    request's fields from the client and the case's random source; `refused` tells a refusal)."""
     path: str
     operations: tuple
     ready: Callable[[Any], None]
-    slow_move: Callable[[Any], int]
+    queue_moves: Callable[[Any], tuple[int, int]]
     speed_back: Callable[[Any], None]
     wait_action: type
     left_out: dict[str, str]
     fixed: dict[str, dict[str, Any]]          # fields held, where only their other values stop
+    bad_only: dict[str, Callable[[Any, random.Random], dict[str, Any]]]
+    refused: Callable[[Any], bool]
 
 
 def call(ros, path: str, srv_type: type, **fields) -> Any:
@@ -102,11 +110,18 @@ def base_speed_back(ros) -> None:
     assert call(ros, BASE + "set_velocity", srv.VehicleSetVelocity, vel=VehicleVelocity(translation=200.0, rotation=45.0)).success
 
 
-def base_slow_move(ros) -> int:
-    """250 mm at 200 mm/s and 500 mm/s²: about 1.5 s with the settle."""
+def base_queue_moves(ros) -> tuple[int, int]:
+    """250 mm at 200 mm/s and 500 mm/s² (about 1.5 s with the settle), then 30 mm further
+    (move_linear_abs: a "servo on" move, which queues behind a moving base)."""
+    here = call(ros, BASE + "get_position", srv.VehicleGetPosition).pos
     r = call(ros, BASE + "move_forward", srv.VehicleMoveForward, x=250.0)
     assert r.success and not r.message, r.message
-    return r.motion_id
+    heading = math.radians(here.theta)
+    beyond = VehiclePosition(x=here.x + 280.0 * math.cos(heading),
+                             y=here.y + 280.0 * math.sin(heading), theta=here.theta)
+    second = call(ros, BASE + "move_linear_abs", srv.VehicleMoveLinearAbs, pos=beyond)
+    assert second.success and not second.message, second.message
+    return r.motion_id, second.motion_id
 
 
 # --- the arm ----------------------------------------------------------------------------------
@@ -118,33 +133,82 @@ def arm_ready(ros) -> None:
     arm_speed_back(ros)
 
 
+@functools.cache
+def arm_startup_speeds(ros) -> tuple[float, ...]:
+    """The joints' max speeds as the node started: read by the first case's ready, before any
+    case fuzzes them."""
+    return tuple(call(ros, ARM + "get_max_speed_joint", srv.GetMaxSpeedJoint).speed)
+
+
 def arm_speed_back(ros) -> None:
-    assert call(ros, ARM + "set_speed_joint", srv.SetSpeedJoint, spd_ratio=10).return_id.id == 0
-    assert call(ros, ARM + "set_speed_cartesian", srv.SetSpeedCartesian,
-                spd_ratio=10).return_id.id == 0
+    """What times a PTP back as the node started (the accel times: config/acti_ros2.yaml), at
+    10 % speed: a case's settings left slow made the next cases' moves crawl (10 s a case)."""
+    for name, srv_type, fields in (
+            ("set_max_speed_joint", srv.SetMaxSpeedJoint, {"speed": arm_startup_speeds(ros)}),
+            ("set_min_accel_time_joint", srv.SetMinAccelTimeJoint, {"acl_time": 0.1}),
+            ("set_accel_time_joint", srv.SetAccelTimeJoint, {"acl_time": 0.3}),
+            ("set_speed_joint", srv.SetSpeedJoint, {"spd_ratio": 10}),
+            ("set_speed_cartesian", srv.SetSpeedCartesian, {"spd_ratio": 10})):
+        answer = call(ros, ARM + name, srv_type, **fields).return_id
+        assert answer.id == 0, f"{name}: {answer.comment}"
 
 
-def arm_slow_move(ros) -> int:
-    """J1 by 10 degree (alternately back) at 10 % of the joint speed."""
+def arm_queue_moves(ros) -> tuple[int, int]:
+    """J1 by 10 degree (alternately back), then 2 degree back, at 10 % of the joint speed."""
     here = call(ros, ARM + "get_feedback_pos_joint", srv.GetFeedbackPosJoint).pos
     step = -10.0 if here[0] > 0.0 else 10.0
-    r = call(ros, ARM + "move_ptp_joint_rel", srv.MovePTPJointRel,
-             joint_points=[step] + [0.0] * (len(here) - 2))
-    assert r.return_id.id == 0, r.return_id.comment
-    return r.motion_id
+    ids = []
+    for j1 in (step, -step / 5):
+        r = call(ros, ARM + "move_ptp_joint_rel", srv.MovePTPJointRel,
+                 joint_points=[j1] + [0.0] * (len(here) - 2))
+        assert r.return_id.id == 0, r.return_id.comment
+        ids.append(r.motion_id)
+    return ids[0], ids[1]
+
+
+# (upper, lower) the arm refuses as a joint and as a Cartesian soft limit (settings.py
+# _limit_value, core.py set_soft_limit_*): not finite, upper below lower, beyond any joint's
+# hardware range and the ±100 m Cartesian bound
+BAD_LIMITS = [(math.nan, -10.0), (10.0, math.nan), (math.inf, -10.0), (10.0, -math.inf),
+              (-10.0, 10.0), (0.0, 5e-324), (1e308, -1e308), (2e5, 0.0)]
+WIDE_LIMIT = (150.0, -150.0)              # within the joints' range and the Cartesian bound
+
+
+def limit_rows(rng: random.Random, count: int) -> list[LimitValue]:
+    """`count` limits, each wide or bad, at least one bad: the request is refused whole."""
+    rows = [rng.choice(BAD_LIMITS + [WIDE_LIMIT]) for _ in range(count)]
+    rows[rng.randrange(count)] = rng.choice(BAD_LIMITS)
+    return [LimitValue(upper=u, lower=lo) for u, lo in rows]
+
+
+def bad_joint_limits(ros, rng: random.Random) -> dict[str, Any]:
+    """Limits for every joint with one bad, or wide ones for too few or too many joints."""
+    joints = len(call(ros, ARM + "get_soft_limit_joint", srv.GetSoftLimitJoint).soft_limit)
+    if rng.random() < 0.5:
+        return {"soft_limit": limit_rows(rng, joints)}
+    wrong = rng.choice([0, 1, joints - 1, joints + 1])
+    return {"soft_limit": [LimitValue(upper=WIDE_LIMIT[0], lower=WIDE_LIMIT[1])] * wrong}
+
+
+def bad_cartesian_limits(ros, rng: random.Random) -> dict[str, Any]:
+    return dict(zip(("x_limit", "y_limit", "z_limit"), limit_rows(rng, 3)))
 
 
 NODES = {
-    "base": Node(BASE, BASE_OPERATIONS, base_ready, base_slow_move, base_speed_back,
+    "base": Node(BASE, BASE_OPERATIONS, base_ready, base_queue_moves, base_speed_back,
                  VehicleWaitMotion, {
                      "stop": "a stop (1.4.33)", "pause": "a hold until resume (1.4.22)",
                      "move_jog": "takes over the running move (by design)",
                      "move_continuous_rel": "takes over the running move (1.4.15)"},
-                 {"set_power": {"on_off": True}, "set_servo": {"on_off": True}}),  # off stops
-    "arm": Node(ARM, ARM_OPERATIONS, arm_ready, arm_slow_move, arm_speed_back, WaitMotion, {
-        "stop": "a stop", "pause": "a hold until resume", "servo_off": "a stop",
-        "set_soft_limit_joint": "a limit the arm is past stops it (alarm 0x4)",
-        "set_soft_limit_cartesian": "a limit the arm is past stops it (alarm 0x5)"}, {}),
+                 {"set_power": {"on_off": True}, "set_servo": {"on_off": True}},  # off stops
+                 {}, lambda answer: not answer.success),
+    "arm": Node(ARM, ARM_OPERATIONS, arm_ready, arm_queue_moves, arm_speed_back, WaitMotion, {
+        "stop": "a stop", "pause": "a hold until resume", "servo_off": "a stop"}, {},
+        # a limit the arm is past stops it (alarm 0x4, 0x5); set_soft_limit_joint answers
+        # STATUS_ERR while the arm moves, before it looks at the values (the cartesian one checks)
+        {"set_soft_limit_joint": bad_joint_limits,
+         "set_soft_limit_cartesian": bad_cartesian_limits},
+        lambda answer: answer.return_id.id != 0),
 }
 CASES = [(node, op.name) for node, n in NODES.items() for op in n.operations
          if op.name not in n.left_out]
@@ -157,21 +221,28 @@ def test_a_request_that_is_no_stop_keeps_the_queued_move(ros, job, node, service
     rng = random.Random(zlib.crc32(f"{node}.{service}".encode()))
     n.ready(ros)
     waits = Actions(ros, n.wait_action, n.path + "wait_motion")
-    motion_id = n.slow_move(ros)
+    first, second = n.queue_moves(ros)
     running: list[int] = []
-    wait = waits.send(lambda f: running.append(f.feedback.current_motion_id),
-                      motion_id=motion_id, timeout=120.0)
-    result = wait.get_result_async()
-    assert ros.spin_until(lambda: motion_id in running or result.done(), 30.0)
-    assert not result.done(), f"{node} motion {motion_id} was over before the requests"
+    results = [waits.send(feedback, motion_id=motion_id, timeout=120.0).get_result_async()
+               for motion_id, feedback in ((first, lambda f: running.append(
+                   f.feedback.current_motion_id)), (second, None))]
+    assert ros.spin_until(lambda: first in running or results[0].done(), 30.0)
+    assert not results[0].done(), f"{node} motion {first} was over before the requests"
+    assert not results[1].done(), f"{node} motion {second} was over before the requests"
     sent = []
-    for _ in range(REQUESTS):                 # while the move runs
-        fields = random_fields(srv_type, rng) | n.fixed.get(service, {})
+    for _ in range(REQUESTS):                 # while the first runs and the second waits
+        if service in n.bad_only:
+            fields = n.bad_only[service](ros, rng)
+            answer = ros.call(srv_type, n.path + service, **fields)
+            assert n.refused(answer), f"{node}.{service} took {fields}: {answer}"
+        else:
+            fields = random_fields(srv_type, rng) | n.fixed.get(service, {})
+            ros.call(srv_type, n.path + service, **fields)
         sent.append(fields)
-        ros.call(srv_type, n.path + service, **fields)
     n.speed_back(ros)
-    assert ros.wait(result, 120.0)
-    result = result.result().result
-    assert result.completed, (f"{node} motion {motion_id} discarded after {service} "
-                              f"{sent}: {getattr(result, 'message', '')}")
+    for motion_id, result in zip((first, second), results):
+        assert ros.wait(result, 120.0)
+        outcome = result.result().result
+        assert outcome.completed, (f"{node} motion {motion_id} (of {first}, {second}) discarded "
+                                   f"after {service} {sent}: {getattr(outcome, 'message', '')}")
     assert job.alive()
