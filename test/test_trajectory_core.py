@@ -164,6 +164,22 @@ def test_a_new_trajectory_replaces_the_running_one(executor, arm):  # noqa: F811
     assert not arm.device.was_discarded(second)
 
 
+def test_a_new_trajectory_replaces_one_accepted_and_not_started_yet(executor, arm):  # noqa: F811
+    """A goal sent right after another, before the simulation picked that one up (an idle
+    loop lets 1 ms pass first), replaces it as it would a running one: it was refused as
+    'the arm is busy' (test_moveit_ros's preemption failed so once in CI)."""
+    follower = ArmTrajectories(arm)
+    first, _ = follower.follow(validate(four_points(0.3, 2.0), ARM_JOINTS, follower.now()), "t")
+    assert arm.device.current is None and arm.device.queue_length == 1      # not started
+    back = RequestedTrajectory(list(ARM_JOINTS), [RequestedPoint(1.0, list(Q0), [0.0] * 7)])
+    second, _ = follower.follow(validate(back, ARM_JOINTS, follower.now()), "u")
+    assert second > first and arm.device.discard_reason(first) == PREEMPTED
+    assert arm.device.queue_length == 1
+    rest(executor, arm)
+    assert np.max(np.abs(arm.feedback_joints - Q0)) < 0.01
+    assert not arm.device.was_discarded(second)
+
+
 def test_servo_off_refuses_a_trajectory(executor, arm):  # noqa: F811
     follower = ArmTrajectories(arm)
     arm.servo_off()

@@ -87,6 +87,9 @@ class ArmTrajectories:
                 if out is not STALE:
                     return out
                 continue
+            if self.device.current is None and self.device.queue \
+                    and self.device.edit(self._preempt_unstarted):
+                continue                            # now planned from rest where it would start
             planned: list[TrajectoryMotion] = []
             try:
                 reply = self.core._submit(self._from_rest(plan_of, planned), label)
@@ -122,6 +125,17 @@ class ArmTrajectories:
             planned.append(TrajectoryMotion(poly, start.finger, self.core.accel_time_joint))
             return planned[-1]
         return plan
+
+    @staticmethod
+    def _preempt_unstarted(device: Device) -> bool:
+        """Under the device's lock: a trajectory accepted and not started yet, alone on the arm
+        (the simulation picks it up within a step or two), is preempted as a running one is:
+        a goal sent right after another replaces it instead of finding the arm busy."""
+        if device.current is None and len(device.queue) == 1 and not device.stopping \
+                and isinstance(device.queue[0].motion, TrajectoryMotion):
+            device.discard_queue(PREEMPTED)
+            return True
+        return False
 
     def _check_idle(self) -> None:
         d = self.device
