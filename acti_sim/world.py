@@ -60,7 +60,14 @@ class PhysicsClient:
 
     def stepSimulation(self) -> None:  # noqa: N802 (pybullet's name)
         with self.lock:
+            if self._step is None:      # the handle is freed: pybullet's own answer, no crash
+                raise pybullet.error("Not connected to physics server.")
             self._step()
+
+    def disconnect(self) -> None:
+        with self.lock:
+            self._step = None
+            pybullet.disconnect(physicsClientId=self._id)
 
 
 @dataclass(frozen=True)

@@ -3,6 +3,7 @@ exactly as pybullet's `stepSimulation` does, other Python threads run while it s
 other pybullet call of the world runs meanwhile (the client's lock)."""
 import sys
 import threading
+import time
 
 import numpy as np
 import pybullet
@@ -33,26 +34,45 @@ def test_it_moves_the_world_as_pybullets_step_does():
 
 
 def test_other_threads_run_while_it_steps():
-    """With no forced switch of the GIL, another thread runs only where this one releases it:
-    it sees the step under way (the client's lock held, taken only around the step here)."""
+    """With no forced switch of the GIL, another thread runs only where this one releases it.
+    It watches for a step under way (the client's lock held, taken only around the step
+    here), handing the GIL back between looks, while this one steps a moving arm: with
+    pybullet's own step it never sees one."""
     world = World()
-    seen, go = [], threading.Event()
+    world.set_arm_targets(np.radians([30.0, 20.0, -10.0, -60.0, 15.0, 40.0, 5.0]))
+    seen, go, done = [], threading.Event(), threading.Event()
 
     def look() -> None:
         go.wait()
-        seen.append(world._p.lock.locked())
+        while not done.is_set():
+            if world._p.lock.locked():
+                seen.append(True)
+                return
+            time.sleep(0)
+        seen.append(False)
     interval = sys.getswitchinterval()
     sys.setswitchinterval(30.0)
     try:
         other = threading.Thread(target=look)
         other.start()
         go.set()
-        world.step()
+        for _ in range(480):
+            world.step()
+            if seen:
+                break
+        done.set()
         other.join()
     finally:
         sys.setswitchinterval(interval)
         world.close()
     assert seen == [True]
+
+
+def test_a_step_after_close_is_pybullets_error_not_a_crash():
+    world = World()
+    world.close()
+    with pytest.raises(pybullet.error, match="Not connected"):
+        world.step()
 
 
 def test_a_missing_symbol_is_said():
